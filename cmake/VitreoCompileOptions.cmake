@@ -1,0 +1,28 @@
+# Compiler options every vitreo target gets through the `vitreo_options` interface library.
+# Floating point is kept strict (no contraction into FMA, no fast-math) so the core gives the same
+# bits on every machine and every -march level: replay and hardware-in-the-loop tests rely on it.
+
+add_library(vitreo_options INTERFACE)
+target_compile_options(vitreo_options INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Woverloaded-virtual
+  -Wimplicit-fallthrough -Wformat=2 -Wundef
+  -ffp-contract=off -fno-fast-math)
+
+if(VITREO_ARCH)
+  target_compile_options(vitreo_options INTERFACE -march=${VITREO_ARCH})
+endif()
+
+if(VITREO_WERROR)
+  target_compile_options(vitreo_options INTERFACE -Werror)
+endif()
+
+if(VITREO_SANITIZE)
+  target_compile_options(vitreo_options INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(vitreo_options INTERFACE -fsanitize=address,undefined)
+endif()
+
+if(VITREO_TSAN)
+  target_compile_options(vitreo_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(vitreo_options INTERFACE -fsanitize=thread)
+endif()

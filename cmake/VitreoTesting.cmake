@@ -1,0 +1,42 @@
+# Helpers for tests and benchmarks, so every folder declares them the same way.
+#
+#   vitreo_add_test(<name> SOURCES a.cpp ... LIBS lib ... LABELS core ...)
+#     A GoogleTest executable whose cases are discovered one CTest test each, with the labels of
+#     the design guide (core, topology, scenes, protocol, drivers, vm, rig, render, instruments,
+#     calibration, scoring, e2e, fuzz) so parts of the suite run alone: `ctest -L core`.
+#
+#   vitreo_add_benchmark(<name> SOURCES a.cpp ... LIBS lib ...)
+#     A Google Benchmark executable placed in <build>/bench/, run by tools/bench.sh.
+
+include(GoogleTest)
+find_package(GTest REQUIRED)
+if(VITREO_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()
+
+function(vitreo_add_test name)
+  cmake_parse_arguments(T "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  if(NOT VITREO_BUILD_TESTS)
+    return()
+  endif()
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 300)
+  endif()
+  add_executable(${name} ${T_SOURCES})
+  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gmock GTest::gtest_main vitreo_options)
+  target_compile_definitions(${name} PRIVATE VITREO_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  gtest_discover_tests(${name}
+    PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    DISCOVERY_TIMEOUT 120)
+endfunction()
+
+function(vitreo_add_benchmark name)
+  cmake_parse_arguments(B "" "" "SOURCES;LIBS" ${ARGN})
+  if(NOT VITREO_BUILD_BENCHMARKS)
+    return()
+  endif()
+  add_executable(${name} ${B_SOURCES})
+  target_link_libraries(${name} PRIVATE ${B_LIBS} benchmark::benchmark benchmark::benchmark_main vitreo_options)
+  target_compile_definitions(${name} PRIVATE VITREO_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bench)
+endfunction()
