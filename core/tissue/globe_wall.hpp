@@ -1,0 +1,42 @@
+#pragma once
+// The inner wall of the globe (the choroid), which tissue cannot cross.
+//
+// The thesis kept tissue inside a bounding sphere around the choroid; since the choroid is not a
+// sphere, the retina poked through anteriorly (ch. 2.3.2). We use the wall's exact shape instead: the
+// globe is star-shaped about its centre, so the wall is a radius R(θ) for each polar angle θ from the
+// +z (anterior) axis, tabulated finely from the anatomical profile and interpolated in cos θ, which
+// costs a square root and a table lookup per vertex.
+#include <array>
+#include <vector>
+
+#include "core/common/types.hpp"
+#include "core/geometry/revolved_mesh.hpp"
+
+namespace vitreo::core {
+
+class GlobeWall {
+ public:
+  // A spherical wall (tests, simple exercises).
+  static GlobeWall sphere(const Vec3& center_mm, double radius_mm);
+  // The wall traced by a meridional profile (z, rho) about the z axis through `center`, which must
+  // be star-shaped as seen from the centre. Throws InvalidArgument otherwise.
+  static GlobeWall from_profile(const Vec3& center_mm, const std::vector<ProfilePoint>& profile);
+
+  const Vec3& center() const { return center_; }
+  // Wall radius in the direction d (need not be normalised, must be non-zero).
+  double radius_toward(const Vec3& d) const;
+  // Signed distance along the ray from the centre: > 0 inside the wall.
+  double clearance(const Vec3& p) const;
+  // Moves p back onto the wall (minus `offset_mm`) along the ray from the centre if it lies beyond.
+  // Returns true if p was moved.
+  bool project_inside(Vec3& p, double offset_mm) const;
+
+ private:
+  static constexpr int kTableSize = 2049;
+  double radius_at_cos(double c) const;
+
+  Vec3 center_ = Vec3::Zero();
+  std::vector<double> radius_by_cos_;  // index i ↔ cos θ = -1 + 2i/(kTableSize-1)
+};
+
+}  // namespace vitreo::core

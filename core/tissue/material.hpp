@@ -1,0 +1,62 @@
+#pragma once
+// Mechanical description of one tissue surface. Values carry units in their names; scenes give a
+// source for each (scenes/materials). Defaults are the retina's.
+#include <string>
+
+namespace vitreo::core {
+
+struct TissueMaterial {
+  std::string name = "retina";
+
+  // Mass: areal density = volumetric density × thickness. Retina 1.0174 g/ml (Michels et al. 1990,
+  // quoted in the thesis ch. 2.3.3), 0.25 mm thick.
+  double density_g_per_mm3 = 1.0174e-3;
+  double thickness_mm = 0.25;
+
+  // In-plane elasticity as a 2-D membrane modulus E·t (Pa·mm = µN/mm). Springs get stiffness
+  // k = E·t · (adjacent rest area) / (rest length)², which reproduces this modulus (with Poisson
+  // ratio 1/3) on an equilateral triangulation (Van Gelder 1998; the thesis used the same
+  // area weighting after Wilhelms & Van Gelder 1997). Retina E ≈ 20 kPa → 5000 µN/mm at 0.25 mm.
+  double membrane_modulus_pa_mm = 5000.0;
+
+  // The thesis' vector springs keep their rest direction as well as their length, which resists
+  // in-surface shear and out-of-surface bending. Stiffness of that direction term relative to the
+  // axial stiffness (0 switches it off).
+  double direction_stiffness_ratio = 0.02;
+
+  // Tearing: a spring stretched past this engineering strain splits (retina tears at 35–55 %
+  // stretch, Michels et al. 1990). Infinity disables tearing.
+  double tear_strain = 0.45;
+
+  // Drag from the surrounding fluid, per unit area (µN·s/mm³ = Pa·s/mm): damps absolute motion so
+  // tissue released in vitreous settles instead of oscillating. A 0.25 mm sheet weighs so little
+  // that the fluid around it, not its own inertia, sets how fast it moves: with 5 Pa·s/mm a net
+  // 600 Pa detachment pressure lifts the retina at ~0.1 m/s rather than flinging it.
+  double drag_pa_s_per_mm = 5.0;
+
+  // Internal (viscoelastic) damping of the springs, as a time constant: each spring carries a
+  // dashpot of coefficient τ·k in parallel (stiffness-proportional Rayleigh damping). Soft tissue is
+  // strongly viscous; without this a light membrane rings after every release. Applied through
+  // XPBD's damped constraint update (Macklin et al. 2016, eq. 26).
+  double internal_damping_s = 0.01;
+
+  // Added mass: a sheet this thin cannot move without moving the fluid around it, and that fluid
+  // outweighs the sheet many times over. Modelled as a fluid layer of this thickness moving with the
+  // tissue (inertia only — it has no weight). A disc of radius a moving broadside carries
+  // 8/3 ρ a³ of fluid (Lamb, Hydrodynamics §108), ≈ 0.85 ρ a per unit area: 1.5 mm matches
+  // the ~2 mm patches that move together in surgery. Ignored above the fluid level (under gas).
+  double entrained_fluid_mm = 1.5;
+
+  // Plasticity: above `plastic_yield_strain` the rest shape creeps toward the current shape at
+  // `plastic_rate_per_s`, so a membrane released after a pull stays roughly where it was left
+  // (surgeons' complaint about springing back, thesis ch. 3). Rate 0 disables it.
+  double plastic_yield_strain = 0.05;
+  double plastic_rate_per_s = 0.0;
+
+  double areal_density_g_per_mm2() const { return density_g_per_mm3 * thickness_mm; }
+
+  // Throws InvalidArgument naming the first value out of its documented range.
+  void validate() const;
+};
+
+}  // namespace vitreo::core

@@ -1,0 +1,127 @@
+// Step stage 2: constraint projection (XPBD, one Gauss–Seidel sweep in mesh order per iteration).
+//
+// The XPBD update of a constraint C with stiffness k over a substep h is
+// Δλ = (−C − λ/(k h²)) / (Σw|∇C|² + 1/(k h²)); multiplied through by k h² it needs no division by a
+// zero compliance. The multiplier λ starts at zero every substep; with one iteration per substep
+// (Small Steps, Macklin et al. 2019 — the real-time default) it is never needed again, so it is only
+// stored when several iterations must accumulate it, as XPBD requires to converge to the implicit
+// solution rather than to an over-stiff one.
+#include <algorithm>
+#include <cmath>
+
+#include "core/tissue/tissue_world.hpp"
+
+namespace vitreo::core {
+
+void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
+  Surface& s = *surfaces_[si];
+  auto view = s.solver_view();
+  const double h2 = h * h;
+  const double ratio = s.material().direction_stiffness_ratio;
+
+  Vec3* x = view.x.data();
+  const double* w = scratch_[si].effective_inverse_mass.data();
+  const Vec3* prev = scratch_[si].previous.data();
+  // Dashpot β = τ k: with γ = β/(k h), XPBD's damped update multiplied through by k h² becomes
+  // Δλ = −(k h² C + τ k h · ∇C·Δx) / (Σw (k h² + τ k h) + 1), Δx the motion in this substep.
+  const double tau_h = s.material().internal_damping_s * h;
+  const auto* ev = view.edge_v.data();
+  const Vec3* rv = view.rest_vec.data();
+  const double* rl = view.rest_len.data();
+  const double* k = view.stiffness.data();
+  const std::uint8_t* alive = view.edge_alive.data();
+  const std::uint32_t ne = static_cast<std::uint32_t>(view.edge_v.size());
+  double* lam = scratch_[si].lambda_distance.data();
+  Vec3* lam_dir = scratch_[si].lambda_direction.data();
+
+  for (std::uint32_t e = 0; e < ne; ++e) {
+    if (!alive[e]) continue;
+    const std::uint32_t a = ev[e][0], b = ev[e][1];
+    const double wa = w[a], wb = w[b], ws = wa + wb;
+    if (ws == 0.0) continue;
+    Vec3 d = x[b] - x[a];
+    const double kh2 = k[e] * h2;
+
+    // The vector spring's rest-direction term (thesis eq. 2.1): C = d − r, a 3-vector constraint.
+    if (ratio > 0.0) {
+      const double kvh2 = ratio * kh2;
+      Vec3 dl = (rv[e] - d) * kvh2;
+      if (accumulate) {
+        dl -= lam_dir[e];
+        dl /= ws * kvh2 + 1.0;
+        lam_dir[e] += dl;
+      } else {
+        dl /= ws * kvh2 + 1.0;
+      }
+      x[a] -= wa * dl;
+      x[b] += wb * dl;
+      d += ws * dl;
+    }
+
+    // Distance term: C = |d| − L.
+    const double len = d.norm();
+    if (!(len > 0.0)) continue;
+    const double c = len - rl[e];
+    const double kth = k[e] * tau_h;
+    const double rate = kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) / len : 0.0;
+    double dl = -c * kh2 - kth * rate;
+    if (accumulate) {
+      dl = (dl - lam[e]) / (ws * (kh2 + kth) + 1.0);
+      lam[e] += dl;
+    } else {
+      dl /= ws * (kh2 + kth) + 1.0;
+    }
+    const Vec3 corr = d * (dl / len);
+    x[a] -= wa * corr;
+    x[b] += wb * corr;
+  }
+}
+
+void TissueWorld::project_attachments(double h, bool accumulate) {
+  const double h2 = h * h;
+  for (auto& at : attachments_) {
+    if (!at.intact) continue;
+    Surface& sa = *surfaces_[at.d.surface_a];
+    auto va = sa.solver_view();
+    Vec3& xa = va.x[at.a.index];
+    const double wa = scratch_[at.d.surface_a].effective_inverse_mass[at.a.index];
+    Vec3* xb = nullptr;
+    double wb = 0.0;
+    Vec3 pb = at.d.world_point_mm;
+    if (at.d.surface_b != AttachmentDescription::kWorld) {
+      auto vb = surfaces_[at.d.surface_b]->solver_view();
+      xb = &vb.x[at.b.index];
+      wb = scratch_[at.d.surface_b].effective_inverse_mass[at.b.index];
+      pb = *xb;
+    }
+    const double ws = wa + wb;
+    if (ws == 0.0) continue;
+    // Zero-length spring: C = pb − pa (vector); its multiplier over h² is the force it carries.
+    const double kh2 = at.d.stiffness_un_per_mm * h2;
+    Vec3 dl = (pb - xa) * kh2;
+    if (accumulate) dl -= at.lambda;
+    dl /= ws * kh2 + 1.0;
+    at.lambda += dl;
+    xa += wa * dl;
+    if (xb) *xb -= wb * dl;
+    const double force = at.lambda.norm() / h2;
+    at.last_force_un = force;
+    at.peak_force_un = std::max(at.peak_force_un, force);
+  }
+}
+
+void TissueWorld::project_wall() {
+  const double offset = settings_.wall_offset_mm;
+  for (auto& sp : surfaces_) {
+    Surface& s = *sp;
+    if (!s.contained_by_globe()) continue;
+    auto view = s.solver_view();
+    const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (view.inverse_mass[v] == 0.0) continue;  // dead and anchored vertices have w = 0
+      wall_.project_inside(view.x[v], offset);
+    }
+  }
+}
+
+}  // namespace vitreo::core

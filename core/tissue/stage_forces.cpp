@@ -1,0 +1,113 @@
+// Step stage 1: external forces, as accelerations per vertex, once per step.
+//
+// Gravity with buoyancy (the retina is barely denser than vitreous, so it sinks slowly; under gas it
+// falls as it would in air), intraocular pressure along triangle normals, the local force functions
+// (detachment), and the drag rate used by the implicit damping in each substep.
+#include <cmath>
+
+#include "core/tissue/tissue_world.hpp"
+
+namespace vitreo::core {
+
+namespace {
+// Within this distance of the wall a vertex counts as lying on it.
+constexpr double kContactTolerance_mm = 1e-2;
+}  // namespace
+
+void TissueWorld::compute_external_accelerations(double h) {
+  const Environment& env = environment_;
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    Surface& s = *surfaces_[si];
+    Scratch& sc = scratch_[si];
+    auto view = s.solver_view();
+    const std::uint32_t n = s.vertex_slots();
+    const double rho = s.material().density_g_per_mm3;
+    const Vec3 g_fluid = env.gravity_mm_s2 * (1.0 - env.fluid_density_g_per_mm3 / rho);
+    const Vec3 g_gas = env.gravity_mm_s2 * (1.0 - env.gas_density_g_per_mm3 / rho);
+    const bool any_gas = std::isfinite(env.fluid_level_z_mm);
+    const double drag = s.material().drag_pa_s_per_mm;
+    const double settling_damping = settings_.settling_damping_per_s;
+
+    // Forces first (µN), converted to accelerations at the end.
+    for (std::uint32_t v = 0; v < n; ++v) sc.acceleration[v] = Vec3::Zero();
+
+    // Intraocular pressure presses the retina outward onto the choroid. It is applied along the
+    // ray from the globe centre, on each vertex's share of the current (stretched) area: directed
+    // by the eye's geometry rather than by triangle orientation, so a crumpled or flipped patch of
+    // detached retina is never driven inward by it. (On a sphere about the centre this is exactly
+    // the normal pressure; tests/core check it against Laplace's law.)
+    const bool pressurised = s.pressurised() && env.apply_pressure && env.intraocular_pressure_pa > 0.0;
+    if (pressurised) {
+      for (std::uint32_t v = 0; v < n; ++v) sc.current_area[v] = 0.0;
+      for (std::uint32_t t = 0; t < view.tri_v.size(); ++t) {
+        if (!view.tri_alive[t]) continue;
+        const auto [a, b, c] = view.tri_v[t];
+        const double third = (view.x[b] - view.x[a]).cross(view.x[c] - view.x[a]).norm() / 6.0;
+        sc.current_area[a] += third;
+        sc.current_area[b] += third;
+        sc.current_area[c] += third;
+      }
+    }
+
+    for (const auto& lf : local_forces_) {
+      if (lf.d.surface != si || lf.d.scale == 0.0 || lf.d.pressure_pa == 0.0) continue;
+      const double p = lf.d.pressure_pa * lf.d.scale;
+      for (std::size_t i = 0; i < lf.d.vertices.size(); ++i) {
+        const std::uint32_t v = lf.d.vertices[i];
+        if (!view.vertex_alive[v]) continue;  // removed by the vitrector since
+        const Vec3 toward = lf.d.toward_point_mm - view.x[v];
+        const double dist = toward.norm();
+        if (!(dist > 1e-9)) continue;
+        const double w = lf.d.weights.empty() ? 1.0 : lf.d.weights[i];
+        sc.acceleration[v] += toward * (p * w * view.vertex_area[v] / dist);
+      }
+    }
+
+    const bool walled = s.contained_by_globe();
+    const double added_per_area = env.fluid_density_g_per_mm3 * s.material().entrained_fluid_mm;
+    const double mu = settings_.wall_friction;
+    const double contact_mm = settings_.wall_offset_mm + kContactTolerance_mm;
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (!view.vertex_alive[v] || view.inverse_mass[v] == 0.0) {
+        sc.acceleration[v] = Vec3::Zero();
+        sc.effective_inverse_mass[v] = 0.0;
+        sc.drag_rate[v] = 0.0;
+        sc.contact_load[v] = 0.0;
+        continue;
+      }
+      // Inertia = own mass + entrained fluid (none under gas); weight acts on the own mass only.
+      const bool in_gas = any_gas && view.x[v].z() > env.fluid_level_z_mm;
+      const double own_mass = 1.0 / view.inverse_mass[v];
+      const double inertia = own_mass + (in_gas ? 0.0 : added_per_area * view.vertex_area[v]);
+      sc.drag_rate[v] = drag * view.vertex_area[v] / inertia + settling_damping;
+      sc.effective_inverse_mass[v] = 1.0 / (inertia * (1.0 + h * sc.drag_rate[v]));
+      const Vec3& g = in_gas ? g_gas : g_fluid;
+      const Vec3 radial = view.x[v] - wall_.center();
+      const double r = radial.norm();
+      if (pressurised && r > 0.0) {
+        sc.acceleration[v] += radial * (env.intraocular_pressure_pa * sc.current_area[v] / r);
+      }
+      Vec3 a = (sc.acceleration[v] + own_mass * g) / inertia;
+      sc.contact_load[v] = 0.0;
+      if (walled) {
+        // Resting contact: where tissue lies on the wall and is pushed into it (intraocular
+        // pressure on the attached retina), the wall pushes back with the normal load and friction
+        // holds the tangential part. Without this the light retina would be flung into the wall
+        // and projected back every substep, jittering at metres per second.
+        if (r > 0.0 && wall_.radius_toward(radial) - r <= contact_mm) {
+          const Vec3 normal = radial / r;
+          const double an = a.dot(normal);
+          if (an > 0.0) {
+            const Vec3 at = a - an * normal;
+            const double at_norm = at.norm();
+            a = at_norm <= mu * an ? Vec3::Zero() : Vec3(at * (1.0 - mu * an / at_norm));
+            sc.contact_load[v] = an;  // the wall's normal reaction, per unit inertia
+          }
+        }
+      }
+      sc.acceleration[v] = a;
+    }
+  }
+}
+
+}  // namespace vitreo::core

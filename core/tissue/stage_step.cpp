@@ -1,0 +1,197 @@
+// The step pipeline: validate → save rollback → forces → substeps (predict, project, velocities) →
+// step-boundary changes (broken attachments, tears) → events.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/tissue/tissue_world.hpp"
+
+namespace vitreo::core {
+
+namespace {
+constexpr double kMaxDt_s = 0.02;
+}
+
+void TissueWorld::save_rollback() {
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    auto view = surfaces_[si]->solver_view();
+    std::copy(view.x.begin(), view.x.end(), scratch_[si].rollback_x.begin());
+    std::copy(view.v.begin(), view.v.end(), scratch_[si].rollback_v.begin());
+  }
+}
+
+void TissueWorld::restore_rollback() {
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    auto view = surfaces_[si]->solver_view();
+    std::copy_n(scratch_[si].rollback_x.begin(), view.x.size(), view.x.begin());
+    std::copy_n(scratch_[si].rollback_v.begin(), view.v.size(), view.v.begin());
+  }
+}
+
+void TissueWorld::integrate_and_predict(double h) {
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    auto view = surfaces_[si]->solver_view();
+    Scratch& sc = scratch_[si];
+    const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
+    for (std::uint32_t v = 0; v < n; ++v) {
+      sc.previous[v] = view.x[v];
+      if (view.inverse_mass[v] == 0.0) continue;
+      // Implicit Euler with drag: (m + h c) v' = m v + h f, i.e. v' = (v + h a) / (1 + h c/m). It
+      // damps any rate without reversing the velocity and gives the right terminal speed; the
+      // constraints then use the matching effective mass (see Scratch::effective_inverse_mass).
+      if (sc.contact_load[v] > 0.0) {
+        // Lying on the wall: no velocity into it (an inelastic contact), and Coulomb friction
+        // takes up to μ·load·h of the sliding speed each substep, so attached retina stays put.
+        const Vec3 normal = (view.x[v] - wall_.center()).normalized();
+        const double vn = view.v[v].dot(normal);
+        if (vn > 0.0) view.v[v] -= vn * normal;
+        const double vt = view.v[v].norm();
+        const double stop = settings_.wall_friction * sc.contact_load[v] * h;
+        view.v[v] *= vt > stop ? 1.0 - stop / vt : 0.0;
+      }
+      view.v[v] = (view.v[v] + h * sc.acceleration[v]) / (1.0 + h * sc.drag_rate[v]);
+      view.x[v] += h * view.v[v];
+    }
+  }
+}
+
+bool TissueWorld::update_velocities(double h) {
+  const double inv_h = 1.0 / h;
+  double checksum = 0.0;  // NaN or infinity anywhere propagates into the sum
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    auto view = surfaces_[si]->solver_view();
+    const Scratch& sc = scratch_[si];
+    const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (view.inverse_mass[v] == 0.0) continue;
+      view.v[v] = (view.x[v] - sc.previous[v]) * inv_h;
+      checksum += view.x[v].x() + view.x[v].y() + view.x[v].z() + view.v[v].x() + view.v[v].y() + view.v[v].z();
+    }
+  }
+  return std::isfinite(checksum);
+}
+
+void TissueWorld::break_attachments() {
+  for (std::uint32_t i = 0; i < attachments_.size(); ++i) {
+    Attachment& at = attachments_[i];
+    if (!at.intact) continue;
+    const bool stale = !surfaces_[at.d.surface_a]->is_current(at.a) ||
+                       (at.d.surface_b != AttachmentDescription::kWorld && !surfaces_[at.d.surface_b]->is_current(at.b));
+    if (stale || at.peak_force_un > at.d.break_force_un) {
+      at.intact = false;
+      const Vec3 p = stale ? at.d.world_point_mm : surfaces_[at.d.surface_a]->position(at.a.index);
+      if (events_.size() < events_.capacity()) {
+        events_.push_back({TissueEventKind::kAttachmentBroken, at.d.surface_a, i, p, at.peak_force_un});
+      }
+    }
+  }
+}
+
+void TissueWorld::find_overstrained() {
+  // Measured on the final positions of the step: inside the sweep a spring's length is still
+  // changing as its neighbours are projected after it.
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
+    Surface& s = *surfaces_[si];
+    const double tear = s.material().tear_strain;
+    if (!std::isfinite(tear)) continue;
+    auto view = s.solver_view();
+    const double f2 = (1.0 + tear) * (1.0 + tear);
+    const std::uint32_t ne = static_cast<std::uint32_t>(view.edge_v.size());
+    for (std::uint32_t e = 0; e < ne; ++e) {
+      if (!view.edge_alive[e]) continue;
+      const auto [a, b] = view.edge_v[e];
+      const double len2 = (view.x[b] - view.x[a]).squaredNorm();
+      const double limit2 = f2 * view.rest_len[e] * view.rest_len[e];
+      if (len2 > limit2 && tear_candidates_.size() < tear_candidates_.capacity()) {
+        tear_candidates_.push_back({si, e, std::sqrt(len2) / view.rest_len[e] - 1.0});
+      }
+    }
+  }
+}
+
+void TissueWorld::tear_overstrained() {
+  if (settings_.max_tears_per_step == 0) return;
+  find_overstrained();
+  if (tear_candidates_.empty()) return;
+  // Most strained first: a tear starts where the pull is, and the crack it opens relieves the
+  // springs around it before they are considered.
+  std::sort(tear_candidates_.begin(), tear_candidates_.end(), [](const TearCandidate& l, const TearCandidate& r) {
+    if (l.strain != r.strain) return l.strain > r.strain;
+    if (l.surface != r.surface) return l.surface < r.surface;
+    return l.edge < r.edge;
+  });
+  int torn = 0;
+  for (const auto& c : tear_candidates_) {
+    if (torn >= settings_.max_tears_per_step) break;
+    Surface& s = *surfaces_[c.surface];
+    if (!s.edge_alive(c.edge)) continue;
+    // Re-check: an earlier tear this step may have relieved it or replaced it.
+    const double strain = s.edge_strain(c.edge);
+    if (!(strain > s.material().tear_strain)) continue;
+    const auto ev = s.edge_vertices(c.edge);
+    const Vec3 where = 0.5 * (s.position(ev[0]) + s.position(ev[1]));
+    const auto result = s.tear_edge(s.edge_id(c.edge));
+    if (!result.status) continue;  // pool full: the spring stays, the next step tries again
+    ++torn;
+    if (events_.size() < events_.capacity()) {
+      events_.push_back({TissueEventKind::kTear, c.surface, c.edge, where, strain});
+    }
+  }
+}
+
+StepReport TissueWorld::step(double dt_s) {
+  StepReport report;
+  events_.clear();
+  tear_candidates_.clear();
+  if (!std::isfinite(dt_s) || !(dt_s > 0.0) || dt_s > kMaxDt_s) {
+    report.ok = false;
+    report.error = "step: dt must be finite and in (0, " + std::to_string(kMaxDt_s) + "] s, got " + std::to_string(dt_s);
+    return report;
+  }
+  for (auto& at : attachments_) at.peak_force_un = 0.0;
+
+  save_rollback();
+  const int substeps = settings_.substeps;
+  const double h = dt_s / substeps;
+  compute_external_accelerations(h);
+  bool finite = true;
+  for (int sub = 0; sub < substeps && finite; ++sub) {
+    integrate_and_predict(h);
+    const bool accumulate = settings_.iterations > 1;
+    if (accumulate) {
+      for (auto& sc : scratch_) {
+        std::fill(sc.lambda_distance.begin(), sc.lambda_distance.end(), 0.0);
+        std::fill(sc.lambda_direction.begin(), sc.lambda_direction.end(), Vec3::Zero());
+      }
+    }
+    for (auto& at : attachments_) at.lambda = Vec3::Zero();
+    for (int it = 0; it < settings_.iterations; ++it) {
+      for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, h, accumulate);
+      project_attachments(h, accumulate);
+      project_wall();
+    }
+    finite = update_velocities(h);
+  }
+
+  if (!finite) {
+    restore_rollback();
+    tear_candidates_.clear();
+    report.ok = false;
+    report.error = "step: the state became non-finite; the step was rolled back";
+    events_.push_back({TissueEventKind::kRolledBack, 0, 0, Vec3::Zero(), 0.0});
+    return report;
+  }
+
+  for (auto& sp : surfaces_) sp->apply_plasticity(dt_s);
+  break_attachments();
+  tear_overstrained();
+  for (const auto& e : events_) {
+    if (e.kind == TissueEventKind::kTear) ++report.tears;
+    if (e.kind == TissueEventKind::kAttachmentBroken) ++report.attachments_broken;
+  }
+  ++step_count_;
+  time_s_ += dt_s;
+  return report;
+}
+
+}  // namespace vitreo::core

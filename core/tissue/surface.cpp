@@ -1,0 +1,588 @@
+#include "core/tissue/surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/common/validate.hpp"
+
+namespace vitreo::core {
+
+namespace {
+
+constexpr double kMinTraction = 0.2;
+constexpr double kMaxTraction = 2.0;
+
+std::uint32_t reserve_for(std::size_t n, const SurfaceCapacity& c) {
+  return static_cast<std::uint32_t>(n + std::max<double>(c.minimum_extra, c.growth_fraction * static_cast<double>(n)));
+}
+
+}  // namespace
+
+Surface::Surface(const SurfaceDescription& d)
+    : material_(d.material), contained_by_globe_(d.contained_by_globe), pressurised_(d.pressurised) {
+  material_.validate();
+  const auto& mesh = d.mesh;
+  const std::size_t nv = mesh.positions.size();
+  if (nv == 0) throw InvalidArgument("surface '" + material_.name + "': no vertices");
+  if (!d.extra_vertex_mass_g.empty() && d.extra_vertex_mass_g.size() != nv) {
+    throw InvalidArgument("surface '" + material_.name + "': extra_vertex_mass_g needs one value per vertex");
+  }
+  require_range(d.capacity.growth_fraction, 0.0, 10.0, "capacity.growth_fraction");
+
+  // Edge count of a triangulated surface is about 1.5 × triangles (+ boundary) + line springs.
+  const std::size_t ne_est = mesh.triangles.size() * 3 / 2 + nv / 8 + d.line_springs.size() + 16;
+  const std::uint32_t vcap = reserve_for(nv, d.capacity);
+  const std::uint32_t ecap = reserve_for(ne_est, d.capacity) + 3 * (vcap - static_cast<std::uint32_t>(nv));
+  const std::uint32_t tcap = reserve_for(mesh.triangles.size(), d.capacity) + 2 * (vcap - static_cast<std::uint32_t>(nv));
+
+  auto reserve_all = [](std::uint32_t n, auto&... vecs) { (vecs.reserve(n), ...); };
+  reserve_all(vcap, x_, v_, rest_, mass_, inverse_mass_, extra_mass_, vertex_area_, vertex_alive_, fixed_,
+              vertex_generation_, first_corner_, free_vertices_);
+  reserve_all(ecap, edge_v_, edge_t_, base_rest_vec_, rest_vec_, rest_len_, stiffness_, edge_traction_, edge_alive_,
+              edge_is_line_, edge_generation_, free_edges_);
+  reserve_all(tcap, tri_v_, tri_e_, tri_rest_area_, tri_alive_, tri_generation_, free_triangles_);
+  next_corner_.reserve(3 * static_cast<std::size_t>(tcap));
+
+  for (std::size_t i = 0; i < nv; ++i) {
+    require_finite(mesh.positions[i], "surface '" + material_.name + "': vertex position");
+    const std::uint32_t v = allocate_vertex();
+    x_[v] = rest_[v] = mesh.positions[i];
+    if (!d.extra_vertex_mass_g.empty()) {
+      require_non_negative(d.extra_vertex_mass_g[i], "extra_vertex_mass_g");
+      extra_mass_[v] = d.extra_vertex_mass_g[i];
+    }
+  }
+
+  for (const auto& t : mesh.triangles) {
+    for (auto i : t) {
+      if (i >= nv) throw InvalidArgument("surface '" + material_.name + "': triangle index out of range");
+    }
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      throw InvalidArgument("surface '" + material_.name + "': triangle repeats a vertex");
+    }
+    const Vec3& a = mesh.positions[t[0]];
+    const double area = 0.5 * (mesh.positions[t[1]] - a).cross(mesh.positions[t[2]] - a).norm();
+    if (!(area > 1e-12)) throw InvalidArgument("surface '" + material_.name + "': degenerate (zero-area) triangle");
+    const std::uint32_t tri = add_triangle(t, area);
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t va = t[k], vb = t[(k + 1) % 3];
+      std::uint32_t e = find_edge(va, vb);
+      if (e == kNone) {
+        e = add_edge(va, vb, rest_[vb] - rest_[va], 1.0);
+      } else if (edge_t_[e][1] != kNone) {
+        throw InvalidArgument("surface '" + material_.name + "': non-manifold edge (shared by more than two triangles)");
+      }
+      tri_e_[tri][k] = e;
+      attach_triangle_to_edge(e, tri);
+    }
+  }
+
+  for (const auto& ls : d.line_springs) {
+    if (ls.a >= nv || ls.b >= nv || ls.a == ls.b) throw InvalidArgument("line spring: bad vertex indices");
+    require_positive(ls.stiffness_un_per_mm, "line spring stiffness");
+    if (find_edge(ls.a, ls.b) != kNone) throw InvalidArgument("line spring duplicates a triangle edge");
+    const Vec3 r = rest_[ls.b] - rest_[ls.a];
+    if (!(r.norm() > 1e-9)) throw InvalidArgument("line spring has zero rest length");
+    const std::uint32_t e = add_edge(ls.a, ls.b, r, 1.0);
+    edge_is_line_[e] = 1;
+    stiffness_[e] = ls.stiffness_un_per_mm;
+  }
+  // find_edge for line springs walks triangle fans, so it does not see them; line springs are
+  // kept in a separate per-vertex search only at build time, which is all they need.
+
+  for (std::uint32_t v = 0; v < vertex_slots(); ++v) update_vertex_mass(v);
+  for (std::uint32_t e = 0; e < edge_slots(); ++e) update_edge_stiffness(e);
+  for (std::uint32_t v = 0; v < vertex_slots(); ++v) {
+    if (!(mass_[v] > 0.0)) {
+      throw InvalidArgument("surface '" + material_.name + "': vertex " + std::to_string(v) +
+                            " has no mass (no triangle and no extra mass)");
+    }
+  }
+}
+
+// ---- Pools ----------------------------------------------------------------------------------
+
+std::uint32_t Surface::allocate_vertex() {
+  std::uint32_t v;
+  if (!free_vertices_.empty()) {
+    v = free_vertices_.back();
+    free_vertices_.pop_back();
+  } else {
+    v = vertex_slots();
+    x_.emplace_back(Vec3::Zero());
+    v_.emplace_back(Vec3::Zero());
+    rest_.emplace_back(Vec3::Zero());
+    mass_.push_back(0.0);
+    inverse_mass_.push_back(0.0);
+    extra_mass_.push_back(0.0);
+    vertex_area_.push_back(0.0);
+    vertex_alive_.push_back(0);
+    fixed_.push_back(0);
+    vertex_generation_.push_back(0);
+    first_corner_.push_back(kNone);
+  }
+  x_[v] = v_[v] = rest_[v] = Vec3::Zero();
+  mass_[v] = inverse_mass_[v] = extra_mass_[v] = vertex_area_[v] = 0.0;
+  vertex_alive_[v] = 1;
+  fixed_[v] = 0;
+  first_corner_[v] = kNone;
+  ++live_vertices_;
+  return v;
+}
+
+std::uint32_t Surface::allocate_edge() {
+  std::uint32_t e;
+  if (!free_edges_.empty()) {
+    e = free_edges_.back();
+    free_edges_.pop_back();
+  } else {
+    e = edge_slots();
+    edge_v_.push_back({kNone, kNone});
+    edge_t_.push_back({kNone, kNone});
+    base_rest_vec_.emplace_back(Vec3::Zero());
+    rest_vec_.emplace_back(Vec3::Zero());
+    rest_len_.push_back(0.0);
+    stiffness_.push_back(0.0);
+    edge_traction_.push_back(1.0);
+    edge_alive_.push_back(0);
+    edge_is_line_.push_back(0);
+    edge_generation_.push_back(0);
+  }
+  edge_t_[e] = {kNone, kNone};
+  edge_alive_[e] = 1;
+  edge_is_line_[e] = 0;
+  ++live_edges_;
+  return e;
+}
+
+std::uint32_t Surface::allocate_triangle() {
+  std::uint32_t t;
+  if (!free_triangles_.empty()) {
+    t = free_triangles_.back();
+    free_triangles_.pop_back();
+  } else {
+    t = triangle_slots();
+    tri_v_.push_back({kNone, kNone, kNone});
+    tri_e_.push_back({kNone, kNone, kNone});
+    tri_rest_area_.push_back(0.0);
+    tri_alive_.push_back(0);
+    tri_generation_.push_back(0);
+    next_corner_.insert(next_corner_.end(), 3, kNone);
+  }
+  tri_alive_[t] = 1;
+  ++live_triangles_;
+  return t;
+}
+
+void Surface::free_edge(std::uint32_t e) {
+  edge_alive_[e] = 0;
+  stiffness_[e] = 0.0;
+  ++edge_generation_[e];
+  free_edges_.push_back(e);
+  --live_edges_;
+}
+
+void Surface::free_triangle(std::uint32_t t) {
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    unlink_corner(t, k);
+    detach_triangle_from_edge(tri_e_[t][k], t);
+  }
+  tri_alive_[t] = 0;
+  ++tri_generation_[t];
+  free_triangles_.push_back(t);
+  --live_triangles_;
+}
+
+std::uint32_t Surface::add_edge(std::uint32_t a, std::uint32_t b, const Vec3& base_rest_vector, double traction) {
+  const std::uint32_t e = allocate_edge();
+  edge_v_[e] = {a, b};
+  base_rest_vec_[e] = base_rest_vector;
+  edge_traction_[e] = traction;
+  refresh_rest(e);
+  return e;
+}
+
+std::uint32_t Surface::add_triangle(std::array<std::uint32_t, 3> v, double rest_area) {
+  const std::uint32_t t = allocate_triangle();
+  tri_v_[t] = v;
+  tri_e_[t] = {kNone, kNone, kNone};
+  tri_rest_area_[t] = rest_area;
+  for (std::uint32_t k = 0; k < 3; ++k) link_corner(t, k);
+  return t;
+}
+
+void Surface::link_corner(std::uint32_t t, std::uint32_t k) {
+  const std::uint32_t c = 3 * t + k, v = tri_v_[t][k];
+  next_corner_[c] = first_corner_[v];
+  first_corner_[v] = c;
+}
+
+void Surface::unlink_corner(std::uint32_t t, std::uint32_t k) {
+  const std::uint32_t c = 3 * t + k, v = tri_v_[t][k];
+  std::uint32_t* link = &first_corner_[v];
+  while (*link != kNone && *link != c) link = &next_corner_[*link];
+  if (*link == c) *link = next_corner_[c];
+  next_corner_[c] = kNone;
+}
+
+void Surface::attach_triangle_to_edge(std::uint32_t e, std::uint32_t t) {
+  if (edge_t_[e][0] == kNone) {
+    edge_t_[e][0] = t;
+  } else {
+    edge_t_[e][1] = t;
+  }
+}
+
+void Surface::detach_triangle_from_edge(std::uint32_t e, std::uint32_t t) {
+  if (e == kNone) return;
+  auto& et = edge_t_[e];
+  if (et[0] == t) {
+    et[0] = et[1];
+    et[1] = kNone;
+  } else if (et[1] == t) {
+    et[1] = kNone;
+  }
+}
+
+std::uint32_t Surface::find_edge(std::uint32_t a, std::uint32_t b) const {
+  for (std::uint32_t c = first_corner_[a]; c != kNone; c = next_corner_[c]) {
+    const std::uint32_t t = c / 3;
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t e = tri_e_[t][k];
+      if (e == kNone) continue;
+      const auto ev = edge_v_[e];
+      if ((ev[0] == a && ev[1] == b) || (ev[0] == b && ev[1] == a)) return e;
+    }
+  }
+  return kNone;
+}
+
+// ---- Derived quantities ---------------------------------------------------------------------
+
+void Surface::refresh_rest(std::uint32_t e) {
+  rest_vec_[e] = base_rest_vec_[e] * (surface_traction_ * edge_traction_[e]);
+  rest_len_[e] = rest_vec_[e].norm();
+}
+
+void Surface::update_vertex_mass(std::uint32_t v) {
+  if (!vertex_alive_[v]) return;
+  double area = 0.0;
+  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) { area += tri_rest_area_[t] / 3.0; });
+  vertex_area_[v] = area;
+  mass_[v] = material_.areal_density_g_per_mm2() * area + extra_mass_[v];
+  inverse_mass_[v] = (fixed_[v] || !(mass_[v] > 0.0)) ? 0.0 : 1.0 / mass_[v];
+}
+
+void Surface::update_edge_stiffness(std::uint32_t e) {
+  if (!edge_alive_[e] || edge_is_line_[e]) return;
+  double area = 0.0;
+  for (auto t : edge_t_[e]) {
+    if (t != kNone) area += tri_rest_area_[t];
+  }
+  const double len2 = base_rest_vec_[e].squaredNorm();
+  // Van Gelder's area weighting (see material.hpp); a boundary edge carries one triangle's share.
+  stiffness_[e] = len2 > 0.0 ? material_.membrane_modulus_pa_mm * area / len2 : 0.0;
+}
+
+double Surface::edge_strain(std::uint32_t e) const {
+  const auto [a, b] = edge_v_[e];
+  return rest_len_[e] > 0.0 ? (x_[b] - x_[a]).norm() / rest_len_[e] - 1.0 : 0.0;
+}
+
+double Surface::total_mass() const {
+  double m = 0.0;
+  for (std::uint32_t v = 0; v < vertex_slots(); ++v) {
+    if (vertex_alive_[v]) m += mass_[v];
+  }
+  return m;
+}
+
+double Surface::total_rest_area() const {
+  double a = 0.0;
+  for (std::uint32_t t = 0; t < triangle_slots(); ++t) {
+    if (tri_alive_[t]) a += tri_rest_area_[t];
+  }
+  return a;
+}
+
+// ---- Edits ------------------------------------------------------------------------------------
+
+Status Surface::set_fixed(VertexId id, bool fixed) {
+  if (!is_current(id)) return Status::error("set_fixed: stale or invalid vertex handle");
+  fixed_[id.index] = fixed ? 1 : 0;
+  if (fixed) v_[id.index] = Vec3::Zero();
+  update_vertex_mass(id.index);
+  return Status::ok();
+}
+
+Status Surface::set_fixed_position(VertexId id, const Vec3& p) {
+  if (!is_current(id)) return Status::error("set_fixed_position: stale or invalid vertex handle");
+  if (!fixed_[id.index]) return Status::error("set_fixed_position: vertex is not fixed");
+  if (!is_finite(p)) return Status::error("set_fixed_position: non-finite position");
+  x_[id.index] = p;
+  return Status::ok();
+}
+
+Status Surface::set_position(VertexId id, const Vec3& p) {
+  if (!is_current(id)) return Status::error("set_position: stale or invalid vertex handle");
+  if (!is_finite(p)) return Status::error("set_position: non-finite position");
+  x_[id.index] = p;
+  return Status::ok();
+}
+
+Status Surface::set_velocity(VertexId id, const Vec3& vel) {
+  if (!is_current(id)) return Status::error("set_velocity: stale or invalid vertex handle");
+  if (!is_finite(vel)) return Status::error("set_velocity: non-finite velocity");
+  v_[id.index] = fixed_[id.index] ? Vec3::Zero() : vel;
+  return Status::ok();
+}
+
+Status Surface::set_surface_traction(double scale) {
+  if (!std::isfinite(scale) || scale < kMinTraction || scale > kMaxTraction) {
+    return Status::error("set_surface_traction: scale must be finite and in [0.2, 2]");
+  }
+  surface_traction_ = scale;
+  for (std::uint32_t e = 0; e < edge_slots(); ++e) {
+    if (edge_alive_[e]) refresh_rest(e);
+  }
+  return Status::ok();
+}
+
+Status Surface::set_edge_traction(EdgeId id, double scale) {
+  if (!is_current(id)) return Status::error("set_edge_traction: stale or invalid edge handle");
+  if (!std::isfinite(scale) || scale < kMinTraction || scale > kMaxTraction) {
+    return Status::error("set_edge_traction: scale must be finite and in [0.2, 2]");
+  }
+  edge_traction_[id.index] = scale;
+  refresh_rest(id.index);
+  return Status::ok();
+}
+
+void Surface::apply_plasticity(double dt_s) {
+  const double rate = material_.plastic_rate_per_s;
+  if (!(rate > 0.0)) return;
+  const double yield = material_.plastic_yield_strain;
+  const double alpha = std::min(1.0, rate * dt_s);
+  for (std::uint32_t e = 0; e < edge_slots(); ++e) {
+    if (!edge_alive_[e]) continue;
+    const auto [a, b] = edge_v_[e];
+    const Vec3 d = x_[b] - x_[a];
+    const double scale = surface_traction_ * edge_traction_[e];
+    const Vec3 current_base = d / scale;  // what the base rest vector would have to be to be at rest
+    const Vec3 diff = current_base - base_rest_vec_[e];
+    const double base_len = base_rest_vec_[e].norm();
+    if (diff.norm() <= yield * base_len) continue;
+    // Creep only by the part beyond the yield, so small elastic deformations still spring back.
+    const Vec3 excess = diff * (1.0 - yield * base_len / diff.norm());
+    base_rest_vec_[e] += alpha * excess;
+    refresh_rest(e);
+  }
+}
+
+Surface::SolverView Surface::solver_view() {
+  return SolverView{x_, v_, inverse_mass_, vertex_alive_, edge_v_, rest_vec_, rest_len_, stiffness_, edge_alive_,
+                    tri_v_, tri_alive_, vertex_area_};
+}
+
+// ---- Tearing ----------------------------------------------------------------------------------
+
+Surface::TearResult Surface::tear_edge(EdgeId id) {
+  TearResult result;
+  if (!is_current(id)) {
+    result.status = Status::error("tear_edge: stale or invalid edge handle");
+    return result;
+  }
+  const std::uint32_t e = id.index;
+  if (edge_is_line_[e]) {
+    result.status = Status::error("tear_edge: line springs have no surface to tear");
+    return result;
+  }
+  const auto tris = edge_t_[e];
+  const int ntri = (tris[0] != kNone) + (tris[1] != kNone);
+  // Worst case: 2 midpoint vertices + 2 vertices un-pinched at the crack's ends; 6 new springs +
+  // up to 4 replaced by un-pinching; 4 triangles for 2 removed.
+  if (vertex_slots() + 4 > x_.capacity() && free_vertices_.size() < 4) {
+    result.status = Status::error("tear_edge: vertex pool full (raise the surface capacity)");
+    return result;
+  }
+  if (edge_slots() + 8 > edge_v_.capacity() && free_edges_.size() < 8) {
+    result.status = Status::error("tear_edge: spring pool full (raise the surface capacity)");
+    return result;
+  }
+  if (triangle_slots() + 4 > tri_v_.capacity() && free_triangles_.size() < 4) {
+    result.status = Status::error("tear_edge: triangle pool full (raise the surface capacity)");
+    return result;
+  }
+
+  const auto [a, b] = edge_v_[e];
+  const Vec3 r_ab = base_rest_vec_[e];
+  const double traction = edge_traction_[e];
+
+  // Two fracture vertices at the spring's midpoint: one stays with a's side, one with b's.
+  const std::uint32_t ma = allocate_vertex();
+  const std::uint32_t mb = allocate_vertex();
+  for (std::uint32_t m : {ma, mb}) {
+    x_[m] = 0.5 * (x_[a] + x_[b]);
+    v_[m] = 0.5 * (v_[a] + v_[b]);
+    rest_[m] = 0.5 * (rest_[a] + rest_[b]);
+  }
+  fixed_[ma] = fixed_[a] && fixed_[b];
+  fixed_[mb] = fixed_[ma];
+
+  // Remember, per adjacent triangle, the opposite vertex, its springs to a and b, and the rest
+  // vector a → opposite, before the triangle goes.
+  struct Side {
+    std::uint32_t opposite = kNone;
+    std::uint32_t e_ao = kNone, e_bo = kNone;
+    Vec3 r_a_opp = Vec3::Zero();
+    double area = 0.0;
+    bool a_first = false;  // triangle order is (a, b, opp) rather than (b, a, opp)
+  };
+  std::array<Side, 2> sides{};
+  for (int i = 0; i < ntri; ++i) {
+    const std::uint32_t t = tris[static_cast<std::size_t>(i)];
+    const auto tv = tri_v_[t];
+    Side& s = sides[static_cast<std::size_t>(i)];
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      if (tv[k] != a && tv[k] != b) s.opposite = tv[k];
+      if (tv[k] == a && tv[(k + 1) % 3] == b) s.a_first = true;
+    }
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t te = tri_e_[t][k];
+      const auto ev = edge_v_[te];
+      const bool has_o = ev[0] == s.opposite || ev[1] == s.opposite;
+      if (has_o && (ev[0] == a || ev[1] == a)) s.e_ao = te;
+      if (has_o && (ev[0] == b || ev[1] == b)) s.e_bo = te;
+    }
+    // Rest vectors live on springs, which may have crept plastically away from the rest positions;
+    // new springs are built from them by vector addition (thesis ch. 2.6.2.1.1).
+    s.r_a_opp = edge_v_[s.e_ao][0] == a ? base_rest_vec_[s.e_ao] : Vec3(-base_rest_vec_[s.e_ao]);
+    s.area = tri_rest_area_[t];
+  }
+  for (int i = 0; i < ntri; ++i) free_triangle(tris[static_cast<std::size_t>(i)]);
+  free_edge(e);
+
+  const std::uint32_t e_a = add_edge(a, ma, 0.5 * r_ab, traction);
+  const std::uint32_t e_b = add_edge(mb, b, 0.5 * r_ab, traction);
+  auto make_triangle = [&](std::array<std::uint32_t, 3> v, std::array<std::uint32_t, 3> edges, double area) {
+    const std::uint32_t t = add_triangle(v, area);
+    tri_e_[t] = edges;
+    for (auto e2 : edges) attach_triangle_to_edge(e2, t);
+  };
+  for (int i = 0; i < ntri; ++i) {
+    const Side& s = sides[static_cast<std::size_t>(i)];
+    const std::uint32_t o = s.opposite;
+    const Vec3 r_m_o = s.r_a_opp - 0.5 * r_ab;  // both fracture vertices rest at the midpoint
+    const std::uint32_t e_mao = add_edge(ma, o, r_m_o, traction);
+    const std::uint32_t e_mbo = add_edge(mb, o, r_m_o, traction);
+    const double half = 0.5 * s.area;
+    if (s.a_first) {  // (a, b, o) → (a, ma, o) and (mb, b, o)
+      make_triangle({a, ma, o}, {e_a, e_mao, s.e_ao}, half);
+      make_triangle({mb, b, o}, {e_b, s.e_bo, e_mbo}, half);
+    } else {  // (b, a, o) → (b, mb, o) and (ma, a, o)
+      make_triangle({b, mb, o}, {e_b, e_mbo, s.e_bo}, half);
+      make_triangle({ma, a, o}, {e_a, s.e_ao, e_mao}, half);
+    }
+  }
+
+  // An opposite vertex that was already on a boundary would now join two separate fans (a
+  // "bow-tie"); give each fan its own vertex so the surface stays manifold.
+  for (int i = 0; i < ntri; ++i) separate_fans(sides[static_cast<std::size_t>(i)].opposite);
+
+  // Local mass and stiffness refresh: every vertex and spring whose adjacent area changed.
+  auto refresh_around = [&](std::uint32_t v) {
+    update_vertex_mass(v);
+    for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        update_edge_stiffness(tri_e_[t][k]);
+        update_vertex_mass(tri_v_[t][k]);
+      }
+    });
+  };
+  refresh_around(ma);
+  refresh_around(mb);
+
+  result.vertex_a_side = ma;
+  result.vertex_b_side = mb;
+  return result;
+}
+
+void Surface::separate_fans(std::uint32_t v) {
+  // Collect v's triangles and group them into fans connected through edges incident to v.
+  std::array<std::uint32_t, 64> tris{};
+  std::array<std::uint8_t, 64> group{};
+  std::size_t n = 0;
+  bool overflow = false;
+  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+    if (n < tris.size()) {
+      tris[n++] = t;
+    } else {
+      overflow = true;
+    }
+  });
+  if (n < 2 || overflow) return;
+  group.fill(0);
+  std::uint8_t groups = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    if (group[s]) continue;
+    ++groups;
+    group[s] = groups;
+    // Flood fill over triangles sharing an edge through v.
+    bool grew = true;
+    while (grew) {
+      grew = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (group[i] != groups) continue;
+        for (std::size_t j = 0; j < n; ++j) {
+          if (group[j]) continue;
+          // Triangles i and j are connected at v when they share an edge incident to v.
+          for (std::uint32_t k = 0; k < 3 && !group[j]; ++k) {
+            const std::uint32_t ei = tri_e_[tris[i]][k];
+            if (ei == kNone || (edge_v_[ei][0] != v && edge_v_[ei][1] != v)) continue;
+            for (std::uint32_t l = 0; l < 3; ++l) {
+              if (tri_e_[tris[j]][l] == ei) {
+                group[j] = groups;
+                grew = true;
+                break;
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  if (groups < 2) return;
+  // Every fan after the first moves to a new copy of v.
+  for (std::uint8_t g = 2; g <= groups; ++g) {
+    if (free_vertices_.empty() && vertex_slots() >= x_.capacity()) return;  // pool full: leave as is
+    const std::uint32_t nv = allocate_vertex();
+    x_[nv] = x_[v];
+    v_[nv] = v_[v];
+    rest_[nv] = rest_[v];
+    fixed_[nv] = fixed_[v];
+    for (std::size_t i = 0; i < n; ++i) {
+      if (group[i] != g) continue;
+      const std::uint32_t t = tris[i];
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        if (tri_v_[t][k] != v) continue;
+        unlink_corner(t, k);
+        tri_v_[t][k] = nv;
+        link_corner(t, k);
+      }
+      // The two edges of t through v: re-home them onto nv (an edge shared with a triangle of
+      // another fan cannot exist, or the fans would be connected).
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        const std::uint32_t e = tri_e_[t][k];
+        if (e == kNone) continue;
+        if (edge_v_[e][0] == v) edge_v_[e][0] = nv;
+        if (edge_v_[e][1] == v) edge_v_[e][1] = nv;
+      }
+    }
+    update_vertex_mass(nv);
+  }
+  update_vertex_mass(v);
+}
+
+}  // namespace vitreo::core

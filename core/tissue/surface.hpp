@@ -1,0 +1,220 @@
+#pragma once
+// One physical tissue surface (retina, membrane, gel layer): vertices joined by springs, grouped into
+// triangles, with stable handles and fixed-capacity pools.
+//
+// Memory is reserved once when the surface is built (with room for cuts and tears) and never grows:
+// topology changes take slots from free lists and refuse, with an error, when the pools are full.
+// That keeps allocation out of the physics step. Vertex data is stored as parallel arrays in mesh
+// order (the order of the generating rings), which is the order the solver sweeps.
+//
+// The model is the thesis' (ch. 2.3): springs that keep a rest length *and* a rest direction ("vector
+// springs"), stiffness weighted by adjacent rest area, vertex mass from adjacent rest area, so total
+// mass is conserved when triangles are subdivided and drops in proportion to removed area.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/common/status.hpp"
+#include "core/common/types.hpp"
+#include "core/geometry/triangle_mesh.hpp"
+#include "core/tissue/handles.hpp"
+#include "core/tissue/material.hpp"
+
+namespace vitreo::core {
+
+struct SurfaceCapacity {
+  // Slots reserved beyond the initial mesh, as a fraction of its size, plus a fixed minimum.
+  double growth_fraction = 0.5;
+  std::uint32_t minimum_extra = 1024;
+};
+
+// A spring that is not an edge of any triangle (a chain, a suture): explicit stiffness, no area.
+struct LineSpring {
+  std::uint32_t a;
+  std::uint32_t b;
+  double stiffness_un_per_mm;
+};
+
+struct SurfaceDescription {
+  TissueMaterial material;
+  TriangleMesh mesh;
+  std::vector<LineSpring> line_springs;
+  // Mass added to individual vertices (g), e.g. the beads of a chain; empty or one per vertex.
+  std::vector<double> extra_vertex_mass_g;
+  // True when the globe wall must keep this surface inside the eye.
+  bool contained_by_globe = true;
+  // True when intraocular pressure presses this surface outward onto the globe wall (the retina
+  // onto the choroid). A membrane floating in vitreous has fluid on both sides: false.
+  bool pressurised = false;
+  SurfaceCapacity capacity;
+};
+
+class Surface {
+ public:
+  // Throws InvalidArgument for an invalid material, non-finite positions, out-of-range indices,
+  // degenerate (zero-area) triangles, or non-manifold input (an edge shared by more than two triangles).
+  explicit Surface(const SurfaceDescription& description);
+
+  const TissueMaterial& material() const { return material_; }
+  bool contained_by_globe() const { return contained_by_globe_; }
+  bool pressurised() const { return pressurised_; }
+
+  // ---- Vertices ----------------------------------------------------------------------------
+  std::uint32_t vertex_slots() const { return static_cast<std::uint32_t>(vertex_alive_.size()); }
+  std::uint32_t vertex_capacity() const { return static_cast<std::uint32_t>(x_.capacity()); }
+  std::uint32_t vertex_count() const { return live_vertices_; }
+  bool vertex_alive(std::uint32_t v) const { return v < vertex_slots() && vertex_alive_[v] != 0; }
+  VertexId vertex_id(std::uint32_t v) const { return {v, vertex_generation_[v]}; }
+  bool is_current(VertexId id) const {
+    return id.index < vertex_slots() && vertex_alive_[id.index] && vertex_generation_[id.index] == id.generation;
+  }
+
+  const Vec3& position(std::uint32_t v) const { return x_[v]; }
+  const Vec3& velocity(std::uint32_t v) const { return v_[v]; }
+  const Vec3& rest_position(std::uint32_t v) const { return rest_[v]; }
+  double mass(std::uint32_t v) const { return mass_[v]; }
+  double extra_mass(std::uint32_t v) const { return extra_mass_[v]; }
+  double inverse_mass(std::uint32_t v) const { return inverse_mass_[v]; }
+  bool is_fixed(std::uint32_t v) const { return fixed_[v] != 0; }
+  double vertex_rest_area(std::uint32_t v) const { return vertex_area_[v]; }
+
+  // Anchors a vertex (ora serrata, optic disc) or frees it. Anchored vertices keep their position
+  // unless moved with set_fixed_position.
+  Status set_fixed(VertexId v, bool fixed);
+  Status set_fixed_position(VertexId v, const Vec3& position_mm);
+  // Moves a free vertex (e.g. to place a scene); velocity is unchanged. Refuses non-finite values.
+  Status set_position(VertexId v, const Vec3& position_mm);
+  Status set_velocity(VertexId v, const Vec3& velocity_mm_s);
+
+  // ---- Springs (edges) -----------------------------------------------------------------------
+  std::uint32_t edge_slots() const { return static_cast<std::uint32_t>(edge_alive_.size()); }
+  std::uint32_t edge_count() const { return live_edges_; }
+  std::uint32_t edge_capacity() const { return static_cast<std::uint32_t>(edge_v_.capacity()); }
+  bool edge_alive(std::uint32_t e) const { return e < edge_slots() && edge_alive_[e] != 0; }
+  EdgeId edge_id(std::uint32_t e) const { return {e, edge_generation_[e]}; }
+  bool is_current(EdgeId id) const {
+    return id.index < edge_slots() && edge_alive_[id.index] && edge_generation_[id.index] == id.generation;
+  }
+  std::array<std::uint32_t, 2> edge_vertices(std::uint32_t e) const { return edge_v_[e]; }
+  std::array<std::uint32_t, 2> edge_triangles(std::uint32_t e) const { return edge_t_[e]; }
+  // Rest length including traction scaling.
+  double edge_rest_length(std::uint32_t e) const { return rest_len_[e]; }
+  const Vec3& edge_rest_vector(std::uint32_t e) const { return rest_vec_[e]; }
+  double edge_stiffness(std::uint32_t e) const { return stiffness_[e]; }
+  double edge_strain(std::uint32_t e) const;
+
+  // Traction (thesis ch. 2.3.1, 2.4): contracting tissue is modelled by scaling rest lengths down.
+  // The effective rest vector is base × surface scale × spring scale. Scales must lie in [0.2, 2].
+  Status set_surface_traction(double scale);
+  Status set_edge_traction(EdgeId e, double scale);
+  double surface_traction() const { return surface_traction_; }
+
+  // ---- Triangles -----------------------------------------------------------------------------
+  std::uint32_t triangle_slots() const { return static_cast<std::uint32_t>(tri_alive_.size()); }
+  std::uint32_t triangle_count() const { return live_triangles_; }
+  bool triangle_alive(std::uint32_t t) const { return t < triangle_slots() && tri_alive_[t] != 0; }
+  TriangleId triangle_id(std::uint32_t t) const { return {t, tri_generation_[t]}; }
+  std::array<std::uint32_t, 3> triangle_vertices(std::uint32_t t) const { return tri_v_[t]; }
+  std::array<std::uint32_t, 3> triangle_edges(std::uint32_t t) const { return tri_e_[t]; }
+  double triangle_rest_area(std::uint32_t t) const { return tri_rest_area_[t]; }
+
+  // Calls f(triangle, corner) for every live triangle using vertex v (corner = 0..2: where v sits).
+  template <class F>
+  void for_each_triangle_of(std::uint32_t v, F&& f) const {
+    for (std::uint32_t c = first_corner_[v]; c != kNone; c = next_corner_[c]) f(c / 3, c % 3);
+  }
+  // The edge joining a and b, or kNone.
+  std::uint32_t find_edge(std::uint32_t a, std::uint32_t b) const;
+
+  // ---- Totals --------------------------------------------------------------------------------
+  double total_mass() const;       // g, sum over live vertices
+  double total_rest_area() const;  // mm², sum over live triangles
+
+  // ---- Topology: tearing ---------------------------------------------------------------------
+  // Splits spring e at its midpoint and opens a crack across it into the adjacent triangles
+  // (thesis ch. 2.6.2.3: a fractured spring becomes two sub-springs with independent fracture
+  // vertices; adjacent triangles are subdivided). The crack is placed exactly at the strained spring,
+  // never at a far vertex. Mass is redistributed from rest areas, so the total is unchanged.
+  // Refuses (and changes nothing) when e is stale or the pools are full. Returns the two new vertices.
+  struct TearResult {
+    Status status = Status::ok();
+    std::uint32_t vertex_a_side = kNone;
+    std::uint32_t vertex_b_side = kNone;
+  };
+  TearResult tear_edge(EdgeId e);
+
+  // ---- Solver access -------------------------------------------------------------------------
+  // The solver works on the raw arrays; these are for it and for the topology code only.
+  struct SolverView;
+  SolverView solver_view();
+
+  // Plastic flow: rest vectors creep toward the current edge vectors where the strain exceeds the
+  // material's yield. Called by the solver once per step.
+  void apply_plasticity(double dt_s);
+
+  // Recomputes mass and inverse mass of vertex v from its adjacent rest area.
+  void update_vertex_mass(std::uint32_t v);
+  // Recomputes the stiffness of triangle edge e from its adjacent rest areas (line springs keep theirs).
+  void update_edge_stiffness(std::uint32_t e);
+
+ private:
+  std::uint32_t allocate_vertex();
+  std::uint32_t allocate_edge();
+  std::uint32_t allocate_triangle();
+  void free_edge(std::uint32_t e);
+  void free_triangle(std::uint32_t t);
+  std::uint32_t add_edge(std::uint32_t a, std::uint32_t b, const Vec3& base_rest_vector, double traction);
+  std::uint32_t add_triangle(std::array<std::uint32_t, 3> v, double rest_area);
+  void link_corner(std::uint32_t t, std::uint32_t k);
+  void unlink_corner(std::uint32_t t, std::uint32_t k);
+  void attach_triangle_to_edge(std::uint32_t e, std::uint32_t t);
+  void detach_triangle_from_edge(std::uint32_t e, std::uint32_t t);
+  void refresh_rest(std::uint32_t e);
+  void separate_fans(std::uint32_t v);
+
+  TissueMaterial material_;
+  bool contained_by_globe_ = true;
+  bool pressurised_ = false;
+  double surface_traction_ = 1.0;
+
+  // Vertices.
+  std::vector<Vec3> x_, v_, rest_;
+  std::vector<double> mass_, inverse_mass_, extra_mass_, vertex_area_;
+  std::vector<std::uint8_t> vertex_alive_, fixed_;
+  std::vector<std::uint32_t> vertex_generation_, first_corner_, free_vertices_;
+  std::uint32_t live_vertices_ = 0;
+
+  // Springs.
+  std::vector<std::array<std::uint32_t, 2>> edge_v_, edge_t_;
+  std::vector<Vec3> base_rest_vec_, rest_vec_;
+  std::vector<double> rest_len_, stiffness_, edge_traction_;
+  std::vector<std::uint8_t> edge_alive_, edge_is_line_;
+  std::vector<std::uint32_t> edge_generation_, free_edges_;
+  std::uint32_t live_edges_ = 0;
+
+  // Triangles.
+  std::vector<std::array<std::uint32_t, 3>> tri_v_, tri_e_;
+  std::vector<std::uint32_t> next_corner_;  // per corner (3 per triangle slot)
+  std::vector<double> tri_rest_area_;
+  std::vector<std::uint8_t> tri_alive_;
+  std::vector<std::uint32_t> tri_generation_, free_triangles_;
+  std::uint32_t live_triangles_ = 0;
+
+};
+
+// Raw arrays handed to the solver (no copies). Valid until the next topology change.
+struct Surface::SolverView {
+  std::span<Vec3> x, v;
+  std::span<const double> inverse_mass;
+  std::span<const std::uint8_t> vertex_alive;
+  std::span<const std::array<std::uint32_t, 2>> edge_v;
+  std::span<const Vec3> rest_vec;
+  std::span<const double> rest_len, stiffness;
+  std::span<const std::uint8_t> edge_alive;
+  std::span<const std::array<std::uint32_t, 3>> tri_v;
+  std::span<const std::uint8_t> tri_alive;
+  std::span<const double> vertex_area;  // lumped rest area per vertex (for drag and local forces)
+};
+
+}  // namespace vitreo::core

@@ -1,0 +1,185 @@
+#include "core/tissue/tissue_world.hpp"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/common/state_hasher.hpp"
+#include "core/common/validate.hpp"
+
+namespace vitreo::core {
+
+void Environment::validate() const {
+  require_finite(gravity_mm_s2, "environment: gravity");
+  if (gravity_mm_s2.norm() > 10.0 * units::kStandardGravity_mm_s2) {
+    throw InvalidArgument("environment: gravity above 10 g");
+  }
+  require_range(fluid_density_g_per_mm3, 0.0, 1e-2, "environment: fluid density");
+  require_range(gas_density_g_per_mm3, 0.0, 1e-2, "environment: gas density");
+  if (std::isnan(fluid_level_z_mm)) throw InvalidArgument("environment: fluid level is NaN");
+  // Documented range: 0 (open globe) to 80 mmHg (severe glaucoma crisis).
+  require_range(intraocular_pressure_pa, 0.0, units::mmhg_to_pa(80.0), "environment: intraocular pressure");
+}
+
+void SolverSettings::validate() const {
+  if (substeps < 1 || substeps > 64) throw InvalidArgument("solver: substeps must be in [1, 64]");
+  if (iterations < 1 || iterations > 64) throw InvalidArgument("solver: iterations must be in [1, 64]");
+  if (max_tears_per_step < 0 || max_tears_per_step > 1024) {
+    throw InvalidArgument("solver: max_tears_per_step must be in [0, 1024]");
+  }
+  require_range(wall_offset_mm, 0.0, 5.0, "solver: wall_offset_mm");
+  require_range(settling_damping_per_s, 0.0, 1e4, "solver: settling_damping_per_s");
+  require_range(wall_friction, 0.0, 10.0, "solver: wall_friction");
+}
+
+TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings settings)
+    : wall_(std::move(wall)), environment_(environment), settings_(settings) {
+  environment_.validate();
+  settings_.validate();
+  events_.reserve(256);
+  tear_candidates_.reserve(4096);
+}
+
+std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
+  auto surface = std::make_unique<Surface>(description);
+  const std::size_t cap = surface->vertex_capacity();
+  Scratch s;
+  s.previous.resize(cap);
+  s.acceleration.resize(cap);
+  s.rollback_x.resize(cap);
+  s.rollback_v.resize(cap);
+  s.drag_rate.resize(cap);
+  s.effective_inverse_mass.resize(cap);
+  s.current_area.resize(cap);
+  s.contact_load.resize(cap);
+  s.lambda_distance.resize(surface->edge_capacity());
+  s.lambda_direction.resize(surface->edge_capacity());
+  surfaces_.push_back(std::move(surface));
+  scratch_.push_back(std::move(s));
+  return static_cast<std::uint32_t>(surfaces_.size() - 1);
+}
+
+std::uint32_t TissueWorld::add_attachment(const AttachmentDescription& d) {
+  if (d.surface_a >= surfaces_.size()) throw InvalidArgument("attachment: surface_a out of range");
+  const Surface& sa = *surfaces_[d.surface_a];
+  if (!sa.vertex_alive(d.vertex_a)) throw InvalidArgument("attachment: vertex_a is not a live vertex");
+  Attachment a{d, sa.vertex_id(d.vertex_a), {}, true, 0.0, 0.0, Vec3::Zero()};
+  if (d.surface_b == AttachmentDescription::kWorld) {
+    require_finite(d.world_point_mm, "attachment: world point");
+  } else {
+    if (d.surface_b >= surfaces_.size()) throw InvalidArgument("attachment: surface_b out of range");
+    const Surface& sb = *surfaces_[d.surface_b];
+    if (!sb.vertex_alive(d.vertex_b)) throw InvalidArgument("attachment: vertex_b is not a live vertex");
+    if (d.surface_a == d.surface_b && d.vertex_a == d.vertex_b) throw InvalidArgument("attachment binds a vertex to itself");
+    a.b = sb.vertex_id(d.vertex_b);
+  }
+  require_range(d.stiffness_un_per_mm, 1e-6, 1e12, "attachment: stiffness");
+  if (std::isnan(d.break_force_un) || !(d.break_force_un > 0.0)) {
+    throw InvalidArgument("attachment: break force must be > 0 (infinity = unbreakable)");
+  }
+  attachments_.push_back(a);
+  return static_cast<std::uint32_t>(attachments_.size() - 1);
+}
+
+std::uint32_t TissueWorld::add_local_force(const LocalForceDescription& d) {
+  if (d.surface >= surfaces_.size()) throw InvalidArgument("local force '" + d.name + "': surface out of range");
+  const Surface& s = *surfaces_[d.surface];
+  for (auto v : d.vertices) {
+    if (!s.vertex_alive(v)) throw InvalidArgument("local force '" + d.name + "': vertex is not live");
+  }
+  if (!d.weights.empty() && d.weights.size() != d.vertices.size()) {
+    throw InvalidArgument("local force '" + d.name + "': weights must match vertices");
+  }
+  for (double w : d.weights) require_range(w, 0.0, 1.0, "local force '" + d.name + "': weight");
+  require_finite(d.toward_point_mm, "local force '" + d.name + "': toward point");
+  require_range(d.pressure_pa, -1e5, 1e5, "local force '" + d.name + "': pressure");
+  require_range(d.scale, 0.0, 1.0, "local force '" + d.name + "': scale");
+  local_forces_.push_back({d});
+  return static_cast<std::uint32_t>(local_forces_.size() - 1);
+}
+
+Status TissueWorld::set_environment(const Environment& environment) {
+  try {
+    environment.validate();
+  } catch (const InvalidArgument& e) {
+    return Status::error(e.what());
+  }
+  environment_ = environment;
+  return Status::ok();
+}
+
+Status TissueWorld::set_local_force_scale(std::uint32_t force, double scale) {
+  if (force >= local_forces_.size()) return Status::error("set_local_force_scale: no such force");
+  if (!std::isfinite(scale) || scale < 0.0 || scale > 1.0) {
+    return Status::error("set_local_force_scale: scale must be finite and in [0, 1]");
+  }
+  local_forces_[force].d.scale = scale;
+  return Status::ok();
+}
+
+double TissueWorld::total_mass() const {
+  double m = 0.0;
+  for (const auto& s : surfaces_) m += s->total_mass();
+  return m;
+}
+
+Energy TissueWorld::energy() const {
+  Energy en;
+  for (const auto& sp : surfaces_) {
+    const Surface& s = *sp;
+    const double buoyant = 1.0 - environment_.fluid_density_g_per_mm3 / s.material().density_g_per_mm3;
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      if (!s.vertex_alive(v)) continue;
+      en.kinetic += 0.5 * s.mass(v) * s.velocity(v).squaredNorm();
+      en.gravity -= s.mass(v) * buoyant * environment_.gravity_mm_s2.dot(s.position(v));
+    }
+    const double ratio = s.material().direction_stiffness_ratio;
+    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+      if (!s.edge_alive(e)) continue;
+      const auto [a, b] = s.edge_vertices(e);
+      const Vec3 d = s.position(b) - s.position(a);
+      const double k = s.edge_stiffness(e);
+      const double stretch = d.norm() - s.edge_rest_length(e);
+      en.elastic += 0.5 * k * stretch * stretch + 0.5 * ratio * k * (d - s.edge_rest_vector(e)).squaredNorm();
+    }
+  }
+  for (const auto& at : attachments_) {
+    if (!at.intact) continue;
+    const Vec3 pa = surfaces_[at.d.surface_a]->position(at.a.index);
+    const Vec3 pb = at.d.surface_b == AttachmentDescription::kWorld ? at.d.world_point_mm
+                                                                     : surfaces_[at.d.surface_b]->position(at.b.index);
+    en.elastic += 0.5 * at.d.stiffness_un_per_mm * (pb - pa).squaredNorm();
+  }
+  return en;
+}
+
+std::uint64_t TissueWorld::state_hash() const {
+  StateHasher h;
+  h.add_u64(step_count_);
+  h.add_double(time_s_);
+  for (const auto& sp : surfaces_) {
+    const Surface& s = *sp;
+    h.add_u64(s.vertex_slots());
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      if (!s.vertex_alive(v)) {
+        h.add_u64(0xdead);
+        continue;
+      }
+      h.add_vec3(s.position(v));
+      h.add_vec3(s.velocity(v));
+    }
+    h.add_u64(s.edge_slots());
+    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+      if (!s.edge_alive(e)) continue;
+      const auto ev = s.edge_vertices(e);
+      h.add_u64((std::uint64_t{ev[0]} << 32) | ev[1]);
+      h.add_vec3(s.edge_rest_vector(e));
+    }
+    h.add_u64(s.triangle_slots());
+  }
+  for (const auto& at : attachments_) h.add_u64(at.intact ? 1 : 0);
+  for (const auto& f : local_forces_) h.add_double(f.d.scale);
+  return h.value();
+}
+
+}  // namespace vitreo::core

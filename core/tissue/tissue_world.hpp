@@ -1,0 +1,206 @@
+#pragma once
+// The deformable part of the eye: tissue surfaces, the attachments between them, the globe wall, the
+// forces of the environment and the local force functions — and the step that advances them.
+//
+// Structure after MuJoCo's "constant model, mutable data" idea, kept simple: everything is built
+// before the loop (add_surface, add_attachment, add_local_force), then step() is called at a fixed
+// rate with dt as a parameter. The world owns no clock and no thread; two worlds built and stepped
+// the same way end in the same bits (state_hash()).
+//
+// The solver is XPBD (Macklin, Müller & Chentanez 2016) with several substeps of one iteration each
+// ("Small Steps", Macklin et al. 2019): compliance makes stiffness independent of step size and
+// iteration count, and small substeps keep it stable at dt = 1 ms for every stiffness in the
+// material range, and when tiny triangles appear after a cut.
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/common/status.hpp"
+#include "core/common/types.hpp"
+#include "core/common/units.hpp"
+#include "core/tissue/globe_wall.hpp"
+#include "core/tissue/surface.hpp"
+
+namespace vitreo::core {
+
+struct Environment {
+  // Eye frame: origin at the globe centre, +z anterior. The patient lies supine, so gravity points
+  // to the posterior pole (−z).
+  Vec3 gravity_mm_s2{0.0, 0.0, -units::kStandardGravity_mm_s2};
+  double fluid_density_g_per_mm3 = 1.0033e-3;  // liquid vitreous (Michels et al. 1990)
+  double gas_density_g_per_mm3 = 1.2e-6;       // air after a fluid–gas exchange
+  // Below this height the chamber is filled with fluid, above it with gas (thesis ch. 2.6.2.4).
+  double fluid_level_z_mm = std::numeric_limits<double>::infinity();
+  double intraocular_pressure_pa = units::mmhg_to_pa(15.0);
+  // Pressure acts only where it has something to push against: set false for free-floating tests.
+  bool apply_pressure = true;
+
+  void validate() const;
+};
+
+struct SolverSettings {
+  int substeps = 2;    // per step, 1..64
+  int iterations = 1;  // constraint sweeps per substep, 1..64
+  int max_tears_per_step = 8;
+  double wall_offset_mm = 0.0;  // tissue keeps this distance inside the wall
+  // Mass-proportional velocity damping (1/s) on top of fluid drag: used to settle a case to
+  // equilibrium on load and by tests; 0 during surgery.
+  double settling_damping_per_s = 0.0;
+  // Friction between tissue and the globe wall (retina on the pigment epithelium): a vertex in
+  // contact stays put while the tangential load is below this fraction of the normal load.
+  double wall_friction = 0.5;
+  void validate() const;
+};
+
+// Binds a vertex of one surface to a vertex of another (the thesis' instance vertices), or to a fixed
+// point of the eye (an adhesion, a laser scar). It breaks when the force holding it exceeds its
+// strength: weak attachments let go when pulled, strong ones must be cut.
+struct AttachmentDescription {
+  static constexpr std::uint32_t kWorld = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t surface_a = 0;
+  std::uint32_t vertex_a = 0;
+  std::uint32_t surface_b = kWorld;
+  std::uint32_t vertex_b = 0;
+  Vec3 world_point_mm = Vec3::Zero();  // used when surface_b == kWorld
+  double stiffness_un_per_mm = 1e4;    // µN/mm; large values approach a rigid weld
+  double break_force_un = std::numeric_limits<double>::infinity();
+};
+
+// A force per unit area (Pa) on a set of vertices toward a point: the thesis' detachment force
+// (subretinal fluid pushing the retina off the choroid, ch. 2.4), ramped by `scale` — drainage
+// ramps it to zero.
+struct LocalForceDescription {
+  std::string name;
+  std::uint32_t surface = 0;
+  std::vector<std::uint32_t> vertices;
+  std::vector<double> weights;  // per vertex, 0..1; empty = all 1
+  Vec3 toward_point_mm = Vec3::Zero();
+  double pressure_pa = 0.0;
+  double scale = 1.0;
+};
+
+enum class TissueEventKind : std::uint8_t { kTear, kAttachmentBroken, kRolledBack };
+
+struct TissueEvent {
+  TissueEventKind kind;
+  std::uint32_t surface;
+  std::uint32_t item;  // edge torn / attachment index
+  Vec3 position_mm;
+  double magnitude;  // strain for a tear, force (µN) for a broken attachment
+};
+
+struct StepReport {
+  bool ok = true;             // false: the step was rolled back
+  std::string error;          // why, when !ok
+  std::uint32_t tears = 0;
+  std::uint32_t attachments_broken = 0;
+};
+
+struct Energy {
+  double kinetic = 0.0;
+  double gravity = 0.0;  // with buoyancy, relative to z = 0
+  double elastic = 0.0;  // springs and attachments
+  double total() const { return kinetic + gravity + elastic; }
+};
+
+class TissueWorld {
+ public:
+  TissueWorld(GlobeWall wall, Environment environment = {}, SolverSettings settings = {});
+
+  // ---- Building (before the loop; throws InvalidArgument on bad data) ------------------------
+  std::uint32_t add_surface(const SurfaceDescription& description);
+  std::uint32_t add_attachment(const AttachmentDescription& description);
+  std::uint32_t add_local_force(const LocalForceDescription& description);
+
+  // ---- Run-time controls (never throw) --------------------------------------------------------
+  Status set_environment(const Environment& environment);
+  Status set_local_force_scale(std::uint32_t force, double scale);
+  double local_force_scale(std::uint32_t force) const { return local_forces_.at(force).d.scale; }
+
+  // Advances the world by dt_s (0 < dt ≤ 0.02 s). Topology changes (tears) and broken attachments
+  // happen at the end, at the step boundary. If the state would become non-finite, the whole step is
+  // rolled back and reported.
+  StepReport step(double dt_s);
+
+  // ---- Inspection -----------------------------------------------------------------------------
+  std::uint32_t surface_count() const { return static_cast<std::uint32_t>(surfaces_.size()); }
+  Surface& surface(std::uint32_t i) { return *surfaces_.at(i); }
+  const Surface& surface(std::uint32_t i) const { return *surfaces_.at(i); }
+  const GlobeWall& wall() const { return wall_; }
+  const Environment& environment() const { return environment_; }
+  const SolverSettings& settings() const { return settings_; }
+  std::uint32_t attachment_count() const { return static_cast<std::uint32_t>(attachments_.size()); }
+  bool attachment_intact(std::uint32_t i) const { return attachments_.at(i).intact; }
+  // Force the attachment carried during the last step (µN): the constraint multiplier over h².
+  double attachment_force(std::uint32_t i) const { return attachments_.at(i).last_force_un; }
+  // Events of the last step (valid until the next step).
+  const std::vector<TissueEvent>& events() const { return events_; }
+  std::uint64_t step_count() const { return step_count_; }
+  double time_s() const { return time_s_; }
+
+  double total_mass() const;
+  Energy energy() const;
+  std::uint64_t state_hash() const;
+
+ private:
+  struct Attachment {
+    AttachmentDescription d;
+    VertexId a, b;
+    bool intact = true;
+    double last_force_un = 0.0;
+    double peak_force_un = 0.0;
+    Vec3 lambda = Vec3::Zero();  // accumulated over the iterations of a substep
+  };
+  struct LocalForce {
+    LocalForceDescription d;
+  };
+  struct Scratch {  // per surface, sized to capacity once
+    std::vector<Vec3> previous, acceleration, rollback_x, rollback_v;
+    std::vector<double> drag_rate;
+    // Inverse mass seen by the constraints during this step: 1 / (m + h·c). Treating drag
+    // implicitly adds h·c to the mass in the substep's equations; using the same effective mass
+    // in prediction and projection keeps static equilibria and force estimates unbiased by drag.
+    std::vector<double> effective_inverse_mass;
+    std::vector<double> current_area;  // each vertex's share of the current (stretched) area
+    // Normal load (acceleration) with which a vertex lies on the globe wall; 0 when not in contact.
+    std::vector<double> contact_load;
+    // Constraint multipliers accumulated over the iterations of one substep (only with
+    // iterations > 1; a single iteration starts every constraint from zero).
+    std::vector<double> lambda_distance;
+    std::vector<Vec3> lambda_direction;
+  };
+  struct TearCandidate {
+    std::uint32_t surface;
+    std::uint32_t edge;
+    double strain;
+  };
+
+  // Stages of a step (one file each: stage_forces.cpp, stage_constraints.cpp, stage_step.cpp).
+  void compute_external_accelerations(double h);
+  void integrate_and_predict(double h);
+  void project_springs(std::uint32_t s, double h, bool accumulate);
+  void project_attachments(double h, bool accumulate);
+  void project_wall();
+  bool update_velocities(double h);
+  void break_attachments();
+  void find_overstrained();
+  void tear_overstrained();
+  void save_rollback();
+  void restore_rollback();
+
+  GlobeWall wall_;
+  Environment environment_;
+  SolverSettings settings_;
+  std::vector<std::unique_ptr<Surface>> surfaces_;
+  std::vector<Scratch> scratch_;
+  std::vector<Attachment> attachments_;
+  std::vector<LocalForce> local_forces_;
+  std::vector<TissueEvent> events_;
+  std::vector<TearCandidate> tear_candidates_;
+  std::uint64_t step_count_ = 0;
+  double time_s_ = 0.0;
+};
+
+}  // namespace vitreo::core

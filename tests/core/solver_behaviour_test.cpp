@@ -1,0 +1,319 @@
+// Properties the solver must keep: energy never grows without input, tears at the configured
+// strain, attachments break at their strength, the retina stays inside the globe, runs are
+// deterministic, bad input is refused, and a step that would go non-finite is rolled back.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/anatomy/retina_cap.hpp"
+#include "core/tissue/surface_validity.hpp"
+#include "core/tissue/tissue_world.hpp"
+#include "test_meshes.hpp"
+
+using namespace vitreo::core;
+
+namespace {
+
+GlobeWall far_wall() { return GlobeWall::sphere(Vec3::Zero(), 1e6); }
+
+RetinaCapOptions small_retina() {
+  RetinaCapOptions o;
+  o.retina_vertices = 2000;
+  return o;
+}
+
+}  // namespace
+
+TEST(SolverBehaviour, EnergyNeverGrowsWithoutInput) {
+  // A sheet pinned along one edge, perturbed randomly, under gravity, with no drag: the only
+  // energy is what it starts with.
+  SurfaceDescription d;
+  d.mesh = test::rectangle(4.0, 4.0, 10, 10);
+  d.material.drag_pa_s_per_mm = 0.0;
+  d.material.tear_strain = INFINITY;
+  d.contained_by_globe = false;
+  Environment env;
+  env.apply_pressure = false;
+  TissueWorld world(far_wall(), env);
+  Surface& s = world.surface(world.add_surface(d));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+    if (s.rest_position(v).y() == 0.0) {
+      ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+    } else {
+      const Vec3 jitter(u(rng), u(rng), u(rng));
+      ASSERT_TRUE(s.set_position(s.vertex_id(v), s.position(v) + jitter));
+    }
+  }
+  const double e0 = world.energy().total();
+  double emax = e0;
+  for (int i = 0; i < 2000; ++i) {
+    ASSERT_TRUE(world.step(1e-3).ok);
+    emax = std::max(emax, world.energy().total());
+  }
+  EXPECT_LE(emax, e0 + 1e-9 * std::abs(e0));
+  EXPECT_LT(world.energy().total(), e0);
+}
+
+TEST(SolverBehaviour, ASpringTearsAtTheConfiguredStrain) {
+  for (double tear : {0.35, 0.55}) {
+    SurfaceDescription d;
+    d.mesh = test::rectangle(6.0, 1.0, 12, 2);
+    d.material.tear_strain = tear;
+    d.material.direction_stiffness_ratio = 0.0;
+    d.contained_by_globe = false;
+    Environment env;
+    env.gravity_mm_s2 = Vec3::Zero();
+    env.apply_pressure = false;
+    SolverSettings settings;
+    settings.substeps = 4;
+    settings.iterations = 4;
+    TissueWorld world(far_wall(), env, settings);
+    Surface& s = world.surface(world.add_surface(d));
+    std::vector<std::uint32_t> pulled;
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      if (s.rest_position(v).x() == 0.0) {
+        ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+      }
+      if (s.rest_position(v).x() == 6.0) {
+        ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+        pulled.push_back(v);
+      }
+    }
+    // Pull the right edge slowly (quasi-static: 6 mm/s) and watch the largest strain.
+    double strain_before_tear = 0.0;
+    double torn_at = -1.0;
+    for (int i = 0; i < 4000 && torn_at < 0; ++i) {
+      for (auto v : pulled) {
+        ASSERT_TRUE(s.set_fixed_position(s.vertex_id(v), s.position(v) + Vec3(0.006, 0, 0)));
+      }
+      double max_strain = 0.0;
+      for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+        if (s.edge_alive(e)) max_strain = std::max(max_strain, s.edge_strain(e));
+      }
+      const auto r = world.step(1e-3);
+      ASSERT_TRUE(r.ok);
+      if (r.tears > 0) {
+        torn_at = world.events().front().magnitude;
+        EXPECT_EQ(world.events().front().kind, TissueEventKind::kTear);
+      } else {
+        strain_before_tear = max_strain;
+      }
+    }
+    ASSERT_GT(torn_at, 0.0) << "no tear for tear_strain " << tear;
+    EXPECT_GE(torn_at, tear);
+    EXPECT_LT(torn_at, tear * 1.05) << "torn well past the configured strain";
+    EXPECT_LE(strain_before_tear, tear * 1.0001) << "a spring survived past its tolerance";
+    EXPECT_TRUE(check_surface(s).ok()) << check_surface(s).summary();
+  }
+}
+
+TEST(SolverBehaviour, AnAttachmentCarriesItsLoadAndBreaksAtItsStrength) {
+  // One triangle hanging from the eye wall by an attachment at each corner. Its buoyant weight is
+  // m g (1 − ρ_fluid/ρ); each attachment carries a third.
+  SurfaceDescription d;
+  d.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  d.mesh.triangles = {{0, 1, 2}};
+  d.contained_by_globe = false;
+  TissueWorld world(far_wall());
+  const auto sid = world.add_surface(d);
+  const Surface& s = world.surface(sid);
+  const Environment& env = world.environment();
+  const double weight = s.total_mass() * env.gravity_mm_s2.norm() *
+                        (1.0 - env.fluid_density_g_per_mm3 / s.material().density_g_per_mm3);
+  std::vector<std::uint32_t> ids;
+  for (std::uint32_t v = 0; v < 3; ++v) {
+    AttachmentDescription a;
+    a.surface_a = sid;
+    a.vertex_a = v;
+    a.world_point_mm = s.position(v);
+    a.stiffness_un_per_mm = 1e5;
+    a.break_force_un = 0.45 * weight;  // 35 % above its share
+    ids.push_back(world.add_attachment(a));
+  }
+  for (int i = 0; i < 200; ++i) ASSERT_TRUE(world.step(1e-3).ok);
+  double carried = 0.0;
+  for (auto i : ids) {
+    EXPECT_TRUE(world.attachment_intact(i));
+    carried += world.attachment_force(i);
+  }
+  EXPECT_NEAR(carried, weight, 0.01 * weight) << "force estimate from the constraint multipliers";
+
+  // Double gravity: each attachment must now carry 2/3 of the weight, past its strength.
+  Environment heavy = env;
+  heavy.gravity_mm_s2 *= 2.0;
+  ASSERT_TRUE(world.set_environment(heavy));
+  int broken = 0;
+  for (int i = 0; i < 50; ++i) broken += static_cast<int>(world.step(1e-3).attachments_broken);
+  EXPECT_EQ(broken, 3);
+  for (auto i : ids) EXPECT_FALSE(world.attachment_intact(i));
+}
+
+TEST(SolverBehaviour, TheRetinaNeverLeavesTheGlobe) {
+  RetinaCapOptions o = small_retina();
+  o.environment.intraocular_pressure_pa = units::mmhg_to_pa(60.0);  // far above normal
+  o.detachment_pressure_pa = 8000.0;
+  auto scene = build_retina_cap(o);
+  for (int i = 0; i < 600; ++i) {
+    ASSERT_TRUE(scene.world.step(1e-3).ok);
+    const Surface& s = scene.world.surface(scene.retina);
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      ASSERT_GE(scene.world.wall().clearance(s.position(v)), -1e-9) << "vertex " << v << " step " << i;
+    }
+  }
+  // The detachment force really lifted the retina off the wall somewhere.
+  const Surface& s = scene.world.surface(scene.retina);
+  double lift = 0.0;
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) lift = std::max(lift, scene.world.wall().clearance(s.position(v)));
+  EXPECT_GT(lift, 0.5);
+}
+
+TEST(SolverBehaviour, TheSameInputsGiveTheSameBits) {
+  auto run = [](double detachment_pa) {
+    RetinaCapOptions o = small_retina();
+    o.detachment_pressure_pa = detachment_pa;
+    o.membrane_vertices = 300;
+    auto scene = build_retina_cap(o);
+    for (int i = 0; i < 300; ++i) {
+      if (i == 150) {
+        EXPECT_TRUE(scene.world.set_local_force_scale(scene.detachment_force, 0.5));
+      }
+      EXPECT_TRUE(scene.world.step(1e-3).ok);
+    }
+    return scene.world.state_hash();
+  };
+  const auto a = run(3000.0), b = run(3000.0), c = run(3000.0000001);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c) << "the hash must see a change in the inputs";
+}
+
+TEST(SolverBehaviour, MassIsConservedThroughTears) {
+  RetinaCapOptions o = small_retina();
+  o.retina.tear_strain = 0.1;  // fragile, so the detachment tears it
+  o.detachment_pressure_pa = 9000.0;
+  auto scene = build_retina_cap(o);
+  const double m0 = scene.world.total_mass();
+  std::uint32_t tears = 0;
+  for (int i = 0; i < 400; ++i) {
+    const auto r = scene.world.step(1e-3);
+    ASSERT_TRUE(r.ok);
+    tears += r.tears;
+  }
+  EXPECT_GT(tears, 0u);
+  EXPECT_NEAR(scene.world.total_mass(), m0, 1e-12 * m0);
+  const auto report = check_surface(scene.world.surface(scene.retina));
+  EXPECT_TRUE(report.ok()) << report.summary();
+}
+
+TEST(SolverBehaviour, StableAtOneMillisecondAcrossTheDocumentedStiffnessRange) {
+  for (double modulus : {0.0, 1.0, 1e2, 1e4, 1e6}) {
+    RetinaCapOptions o = small_retina();
+    o.retina.membrane_modulus_pa_mm = modulus;
+    o.retina.tear_strain = INFINITY;
+    auto scene = build_retina_cap(o);
+    double vmax = 0.0;
+    for (int i = 0; i < 300; ++i) {
+      ASSERT_TRUE(scene.world.step(1e-3).ok) << "modulus " << modulus;
+      const Surface& s = scene.world.surface(scene.retina);
+      for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) vmax = std::max(vmax, s.velocity(v).norm());
+    }
+    // Nothing in an eye moves at 1 m/s; an instability quickly would.
+    EXPECT_LT(vmax, 1e3) << "modulus " << modulus;
+    // Released, the tissue comes to rest.
+    ASSERT_TRUE(scene.world.set_local_force_scale(scene.detachment_force, 0.0));
+    for (int i = 0; i < 500; ++i) ASSERT_TRUE(scene.world.step(1e-3).ok);
+    EXPECT_LT(scene.world.energy().kinetic, 1e-3) << "modulus " << modulus;
+  }
+}
+
+TEST(SolverBehaviour, TinyTrianglesStayStable) {
+  // A sliver triangle 1e-4 of the others' size next to normal ones, with a stiff material.
+  SurfaceDescription d;
+  d.mesh = test::rectangle(2.0, 2.0, 4, 4);
+  const std::uint32_t n = static_cast<std::uint32_t>(d.mesh.positions.size());
+  d.mesh.positions.emplace_back(2.0 + 1e-3, 2.0 - 5e-4, 0.0);  // hangs off the corner (4,4)=24 and (4,3)=19
+  d.mesh.triangles.push_back({19, n, 24});
+  d.material.membrane_modulus_pa_mm = 1e6;
+  d.contained_by_globe = false;
+  TissueWorld world(far_wall());
+  Surface& s = world.surface(world.add_surface(d));
+  ASSERT_TRUE(s.set_fixed(s.vertex_id(0), true));
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(world.step(1e-3).ok);
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) EXPECT_LT(s.velocity(v).norm(), 1e3);
+}
+
+TEST(SolverBehaviour, BadStepInputIsRefusedAndChangesNothing) {
+  auto scene = build_retina_cap(small_retina());
+  const auto h = scene.world.state_hash();
+  for (double dt : {0.0, -1e-3, std::nan(""), double{INFINITY}, 0.5}) {
+    const auto r = scene.world.step(dt);
+    EXPECT_FALSE(r.ok) << dt;
+    EXPECT_NE(r.error.find("dt"), std::string::npos);
+  }
+  EXPECT_EQ(scene.world.state_hash(), h);
+  EXPECT_FALSE(scene.world.set_local_force_scale(scene.detachment_force, std::nan("")));
+  EXPECT_FALSE(scene.world.set_local_force_scale(scene.detachment_force, 2.0));
+  EXPECT_FALSE(scene.world.set_local_force_scale(99, 0.5));
+  Environment env;
+  env.intraocular_pressure_pa = std::nan("");
+  EXPECT_FALSE(scene.world.set_environment(env));
+  EXPECT_EQ(scene.world.state_hash(), h);
+}
+
+TEST(SolverBehaviour, AStepThatWouldGoNonFiniteIsRolledBack) {
+  auto scene = build_retina_cap(small_retina());
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(scene.world.step(1e-3).ok);
+  Surface& s = scene.world.surface(scene.retina);
+  // A finite but absurd position (a corrupted device value that got through) overflows a spring.
+  std::uint32_t v = 0;
+  while (s.is_fixed(v)) ++v;
+  ASSERT_TRUE(s.set_position(s.vertex_id(v), Vec3(1e300, -1e300, 1e300)));
+  const auto before = scene.world.state_hash();
+  const auto r = scene.world.step(1e-3);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("rolled back"), std::string::npos);
+  EXPECT_EQ(scene.world.state_hash(), before);
+  ASSERT_FALSE(scene.world.events().empty());
+  EXPECT_EQ(scene.world.events().back().kind, TissueEventKind::kRolledBack);
+  // Restoring the vertex lets the simulation carry on.
+  ASSERT_TRUE(s.set_position(s.vertex_id(v), s.rest_position(v)));
+  EXPECT_TRUE(scene.world.step(1e-3).ok);
+}
+
+TEST(SolverBehaviour, PlasticityKeepsAReleasedMembraneNearWhereItWasLeft) {
+  auto run = [](double plastic_rate) -> double {
+    SurfaceDescription d;
+    d.mesh = test::rectangle(4.0, 4.0, 8, 8);
+    d.material.plastic_rate_per_s = plastic_rate;
+    d.material.tear_strain = INFINITY;
+    d.contained_by_globe = false;
+    Environment env;
+    env.gravity_mm_s2 = Vec3::Zero();
+    env.apply_pressure = false;
+    TissueWorld world(far_wall(), env);
+    Surface& s = world.surface(world.add_surface(d));
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      if (s.rest_position(v).x() == 0.0) {
+        EXPECT_TRUE(s.set_fixed(s.vertex_id(v), true));
+      }
+    }
+    const std::uint32_t grip = 4 * 9 + 8;  // middle of the free edge (row 4, column 8)
+    EXPECT_TRUE(s.set_fixed(s.vertex_id(grip), true));
+    // Lift the free edge's middle 2 mm out of plane over 1 s, hold 1 s, release, wait 1 s.
+    bool ok = true;
+    for (int i = 0; i < 1000; ++i) {
+      ok &= s.set_fixed_position(s.vertex_id(grip), s.rest_position(grip) + Vec3(0, 0, 2.0 * (i + 1) / 1000)).is_ok();
+      ok &= world.step(1e-3).ok;
+    }
+    for (int i = 0; i < 1000; ++i) ok &= world.step(1e-3).ok;
+    ok &= s.set_fixed(s.vertex_id(grip), false).is_ok();
+    for (int i = 0; i < 1000; ++i) ok &= world.step(1e-3).ok;
+    EXPECT_TRUE(ok);
+    return s.position(grip).z();
+  };
+  const double elastic = run(0.0), plastic = run(5.0);
+  EXPECT_LT(elastic, 0.5) << "without plasticity the membrane springs back";
+  EXPECT_GT(plastic, 1.0) << "with plasticity it stays roughly where it was left";
+}
