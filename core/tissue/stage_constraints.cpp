@@ -116,10 +116,11 @@ void TissueWorld::project_wall() {
     Surface& s = *sp;
     if (!s.contained_by_globe()) continue;
     auto view = s.solver_view();
+    auto& touched = scratch_[static_cast<std::size_t>(&sp - surfaces_.data())].wall_touched;
     const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
     for (std::uint32_t v = 0; v < n; ++v) {
       if (view.inverse_mass[v] == 0.0) continue;  // dead and anchored vertices have w = 0
-      wall_.project_inside(view.x[v], offset);
+      if (wall_.project_inside(view.x[v], offset)) touched[v] = 1;
     }
   }
 }

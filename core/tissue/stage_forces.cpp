@@ -3,6 +3,7 @@
 // Gravity with buoyancy (the retina is barely denser than vitreous, so it sinks slowly; under gas it
 // falls as it would in air), intraocular pressure along triangle normals, the local force functions
 // (detachment), and the drag rate used by the implicit damping in each substep.
+#include <algorithm>
 #include <cmath>
 
 #include "core/tissue/tissue_world.hpp"
@@ -10,8 +11,8 @@
 namespace vitreo::core {
 
 namespace {
-// Within this distance of the wall a vertex counts as lying on it.
-constexpr double kContactTolerance_mm = 1e-2;
+// Over this distance from the wall its reaction fades in (see below).
+constexpr double kContactBand_mm = 2e-2;
 }  // namespace
 
 void TissueWorld::compute_external_accelerations(double h) {
@@ -66,7 +67,6 @@ void TissueWorld::compute_external_accelerations(double h) {
     const bool walled = s.contained_by_globe();
     const double added_per_area = env.fluid_density_g_per_mm3 * s.material().entrained_fluid_mm;
     const double mu = settings_.wall_friction;
-    const double contact_mm = settings_.wall_offset_mm + kContactTolerance_mm;
     for (std::uint32_t v = 0; v < n; ++v) {
       if (!view.vertex_alive[v] || view.inverse_mass[v] == 0.0) {
         sc.acceleration[v] = Vec3::Zero();
@@ -89,20 +89,25 @@ void TissueWorld::compute_external_accelerations(double h) {
       }
       Vec3 a = (sc.acceleration[v] + own_mass * g) / inertia;
       sc.contact_load[v] = 0.0;
-      if (walled) {
+      if (walled && r > 0.0) {
         // Resting contact: where tissue lies on the wall and is pushed into it (intraocular
         // pressure on the attached retina), the wall pushes back with the normal load and friction
         // holds the tangential part. Without this the light retina would be flung into the wall
-        // and projected back every substep, jittering at metres per second.
-        if (r > 0.0 && wall_.radius_toward(radial) - r <= contact_mm) {
-          const Vec3 normal = radial / r;
-          const double an = a.dot(normal);
-          if (an > 0.0) {
-            const Vec3 at = a - an * normal;
-            const double at_norm = at.norm();
-            a = at_norm <= mu * an ? Vec3::Zero() : Vec3(at * (1.0 - mu * an / at_norm));
-            sc.contact_load[v] = an;  // the wall's normal reaction, per unit inertia
-          }
+        // and projected back every substep. The reaction fades in over the last kContactBand_mm
+        // before the wall, so a vertex near the edge of a detachment settles at a small clearance
+        // instead of switching between "touching" and "free" from one step to the next.
+        const double clearance = wall_.radius_toward(radial) - r - settings_.wall_offset_mm;
+        const double engaged = std::clamp(1.0 - clearance / kContactBand_mm, 0.0, 1.0);
+        const Vec3 normal = radial / r;
+        const double an = a.dot(normal);
+        if (engaged > 0.0 && an > 0.0) {
+          const double reaction = engaged * an;
+          Vec3 at = a - an * normal;
+          const double at_norm = at.norm();
+          const double friction = mu * reaction;
+          at *= at_norm > friction ? 1.0 - friction / at_norm : 0.0;
+          a = at + (an - reaction) * normal;
+          sc.contact_load[v] = reaction;  // the wall's normal reaction, per unit inertia
         }
       }
       sc.acceleration[v] = a;

@@ -60,11 +60,17 @@ bool TissueWorld::update_velocities(double h) {
   double checksum = 0.0;  // NaN or infinity anywhere propagates into the sum
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     auto view = surfaces_[si]->solver_view();
-    const Scratch& sc = scratch_[si];
+    Scratch& sc = scratch_[si];
     const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
     for (std::uint32_t v = 0; v < n; ++v) {
       if (view.inverse_mass[v] == 0.0) continue;
       view.v[v] = (view.x[v] - sc.previous[v]) * inv_h;
+      if (sc.wall_touched[v]) {
+        sc.wall_touched[v] = 0;
+        const Vec3 normal = (view.x[v] - wall_.center()).normalized();
+        const double vn = view.v[v].dot(normal);
+        if (vn > 0.0) view.v[v] -= vn * normal;
+      }
       checksum += view.x[v].x() + view.x[v].y() + view.x[v].z() + view.v[v].x() + view.v[v].y() + view.v[v].z();
     }
   }

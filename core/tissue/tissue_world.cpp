@@ -52,6 +52,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.effective_inverse_mass.resize(cap);
   s.current_area.resize(cap);
   s.contact_load.resize(cap);
+  s.wall_touched.resize(cap);
   s.lambda_distance.resize(surface->edge_capacity());
   s.lambda_direction.resize(surface->edge_capacity());
   surfaces_.push_back(std::move(surface));

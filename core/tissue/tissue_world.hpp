@@ -166,6 +166,10 @@ class TissueWorld {
     std::vector<double> current_area;  // each vertex's share of the current (stretched) area
     // Normal load (acceleration) with which a vertex lies on the globe wall; 0 when not in contact.
     std::vector<double> contact_load;
+    // Set when the wall moved the vertex in this substep: its velocity into the wall is then
+    // removed (an inelastic contact, as in the velocity pass of Müller et al. 2020) so it cannot
+    // bounce between wall and springs from one substep to the next.
+    std::vector<std::uint8_t> wall_touched;
     // Constraint multipliers accumulated over the iterations of one substep (only with
     // iterations > 1; a single iteration starts every constraint from zero).
     std::vector<double> lambda_distance;
