@@ -1,6 +1,7 @@
 #include "core/anatomy/retina_cap.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -36,9 +37,8 @@ RetinaCapScene build_retina_cap(const RetinaCapOptions& o) {
   require_range(o.optic_disc_radius_mm, 0.0, 3.0, "retina cap: optic_disc_radius_mm");
   require_range(o.detachment_radius_deg, 1.0, 90.0, "retina cap: detachment_radius_deg");
   require_range(o.detachment_center_deg, 0.0, 170.0, "retina cap: detachment_center_deg");
-  if (o.membrane_vertices < 0 || o.membrane_attachment_stride < 1) {
-    throw InvalidArgument("retina cap: membrane_vertices must be >= 0 and the stride >= 1");
-  }
+  require_range(o.membrane_radius_deg, 1.0, 90.0, "retina cap: membrane_radius_deg");
+  if (o.membrane_attachment_stride < 1) throw InvalidArgument("retina cap: membrane_attachment_stride must be >= 1");
 
   const double R = o.globe_radius_mm;
   RetinaCapScene scene{TissueWorld(GlobeWall::sphere(Vec3::Zero(), R), o.environment, o.solver)};
@@ -90,37 +90,40 @@ RetinaCapScene build_retina_cap(const RetinaCapOptions& o) {
     scene.detachment_force = world.add_local_force(f);
   }
 
-  if (o.membrane_vertices > 0) {
-    // A membrane cap just inside the retina over the posterior pole.
-    const double r_m = R - 0.05;
+  if (o.membrane) {
     const double extent = o.membrane_radius_deg * kDeg;
+    const Vec3 pole(0.0, 0.0, -R);
+    std::vector<std::uint32_t> to_membrane(nv, kNone);
     SurfaceDescription m;
     m.material = o.retina;
     m.material.name = "epiretinal membrane";
     m.material.membrane_modulus_pa_mm = 4.0 * o.retina.membrane_modulus_pa_mm;
     m.contained_by_globe = true;
-    m.mesh = revolve_profile(sphere_arc_profile(r_m, 0.0, extent, 16),
-                             {edge_length_for_vertex_count(r_m, extent, o.membrane_vertices), 2.0 * std::numbers::pi});
-    scene.membrane = world.add_surface(m);
-    const Surface& ms = world.surface(scene.membrane);
-    // Attach membrane vertices to the nearest retina vertex (its "instance vertex"): ring order
-    // lets a windowed search suffice, but a full scan at build time is simple and fast enough.
-    for (std::uint32_t v = 0; v < ms.vertex_slots(); v += static_cast<std::uint32_t>(o.membrane_attachment_stride)) {
-      const Vec3 p = ms.position(v);
-      std::uint32_t best = 0;
-      double best_d = std::numeric_limits<double>::infinity();
-      for (std::uint32_t u = 0; u < nv; ++u) {
-        const double d = (rs.position(u) - p).squaredNorm();
-        if (d < best_d) {
-          best_d = d;
-          best = u;
+    std::vector<std::uint32_t> from_retina;
+    for (const auto& t : retina.mesh.triangles) {
+      bool inside = true;
+      for (auto v : t) inside = inside && angle_between(retina.mesh.positions[v], pole) <= extent;
+      if (!inside) continue;
+      std::array<std::uint32_t, 3> mt{};
+      for (int k = 0; k < 3; ++k) {
+        const auto v = t[static_cast<std::size_t>(k)];
+        if (to_membrane[v] == kNone) {
+          to_membrane[v] = static_cast<std::uint32_t>(m.mesh.positions.size());
+          m.mesh.positions.push_back(retina.mesh.positions[v]);
+          from_retina.push_back(v);
         }
+        mt[static_cast<std::size_t>(k)] = to_membrane[v];
       }
+      m.mesh.triangles.push_back(mt);
+    }
+    if (m.mesh.triangles.empty()) throw InvalidArgument("retina cap: membrane radius too small for the mesh");
+    scene.membrane = world.add_surface(m);
+    for (std::uint32_t v = 0; v < from_retina.size(); v += static_cast<std::uint32_t>(o.membrane_attachment_stride)) {
       AttachmentDescription a;
       a.surface_a = scene.membrane;
       a.vertex_a = v;
       a.surface_b = scene.retina;
-      a.vertex_b = best;
+      a.vertex_b = from_retina[v];
       a.stiffness_un_per_mm = 2e3;
       a.break_force_un = o.membrane_break_force_un;
       world.add_attachment(a);

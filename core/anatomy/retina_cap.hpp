@@ -28,9 +28,10 @@ struct RetinaCapOptions {
   // millimetres high held by the retina's tension, as in a fresh rhegmatogenous detachment.
   double detachment_pressure_pa = units::mmhg_to_pa(15.0) + 150.0;
 
-  // An epiretinal membrane over the posterior pole, attached to the retina at every
-  // `membrane_attachment_stride`-th membrane vertex; 0 vertices = none.
-  int membrane_vertices = 0;
+  // An epiretinal membrane over the posterior pole: a copy of the retina's mesh within
+  // `membrane_radius_deg` of the pole, attached to the retina at every
+  // `membrane_attachment_stride`-th vertex through coincident "instance vertices" (thesis ch. 2.3.1).
+  bool membrane = false;
   double membrane_radius_deg = 20.0;
   int membrane_attachment_stride = 4;
   double membrane_break_force_un = 50.0;

@@ -9,9 +9,17 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/tissue/awake_vertices.hpp"
 #include "core/tissue/tissue_world.hpp"
 
 namespace vitreo::core {
+
+namespace {
+// An attachment stretched further than this by an awake side wakes its sleeping side.
+constexpr double kAttachmentWake_mm = 5e-3;
+// See the direction term in project_springs.
+constexpr double kMaxDirectionFraction = 0.25;
+}  // namespace
 
 void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
   Surface& s = *surfaces_[si];
@@ -29,29 +37,31 @@ void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
   const Vec3* rv = view.rest_vec.data();
   const double* rl = view.rest_len.data();
   const double* k = view.stiffness.data();
-  const std::uint8_t* alive = view.edge_alive.data();
-  const std::uint32_t ne = static_cast<std::uint32_t>(view.edge_v.size());
   double* lam = scratch_[si].lambda_distance.data();
   Vec3* lam_dir = scratch_[si].lambda_direction.data();
 
-  for (std::uint32_t e = 0; e < ne; ++e) {
-    if (!alive[e]) continue;
+  std::uint8_t* wake = scratch_[si].wake_request.data();
+  const double wake_strain = settings_.wake_strain;
+  for_each_active_edge(si, [&](std::uint32_t e) {
     const std::uint32_t a = ev[e][0], b = ev[e][1];
     const double wa = w[a], wb = w[b], ws = wa + wb;
-    if (ws == 0.0) continue;
+    if (ws == 0.0) return;
     Vec3 d = x[b] - x[a];
     const double kh2 = k[e] * h2;
 
     // The vector spring's rest-direction term (thesis eq. 2.1): C = d − r, a 3-vector constraint.
     if (ratio > 0.0) {
+      // It is a gentle shape memory, not a structural constraint: where it would be stiff for the
+      // substep (k h² w ≫ 1, stiff membranes on a fine mesh) it is capped to remove at most
+      // kMaxDirectionFraction of its violation per substep. Uncapped, a rigid world-frame direction
+      // term fights the length and wall constraints and makes stiff membranes jitter.
       const double kvh2 = ratio * kh2;
-      Vec3 dl = (rv[e] - d) * kvh2;
+      Vec3 dl = (rv[e] - d);
       if (accumulate) {
-        dl -= lam_dir[e];
-        dl /= ws * kvh2 + 1.0;
+        dl = (dl * kvh2 - lam_dir[e]) / (ws * kvh2 + 1.0);
         lam_dir[e] += dl;
       } else {
-        dl /= ws * kvh2 + 1.0;
+        dl *= std::min(kvh2 / (ws * kvh2 + 1.0), kMaxDirectionFraction / ws);
       }
       x[a] -= wa * dl;
       x[b] += wb * dl;
@@ -60,8 +70,13 @@ void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
 
     // Distance term: C = |d| − L.
     const double len = d.norm();
-    if (!(len > 0.0)) continue;
+    if (!(len > 0.0)) return;
     const double c = len - rl[e];
+    // A spring from an awake vertex pulling hard on a sleeping one wakes it for the next step.
+    if ((wa == 0.0 || wb == 0.0) && std::abs(c) > wake_strain * rl[e]) {
+      const std::uint32_t still = wa == 0.0 ? a : b;
+      if (!s.vertex_awake(still)) wake[still / Surface::kSleepBlock] = 1;
+    }
     const double kth = k[e] * tau_h;
     const double rate = kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) / len : 0.0;
     double dl = -c * kh2 - kth * rate;
@@ -74,7 +89,7 @@ void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
     const Vec3 corr = d * (dl / len);
     x[a] -= wa * corr;
     x[b] += wb * corr;
-  }
+  });
 }
 
 void TissueWorld::project_attachments(double h, bool accumulate) {
@@ -96,6 +111,12 @@ void TissueWorld::project_attachments(double h, bool accumulate) {
     }
     const double ws = wa + wb;
     if (ws == 0.0) continue;
+    if ((wa == 0.0 || wb == 0.0) && (pb - xa).squaredNorm() > kAttachmentWake_mm * kAttachmentWake_mm) {
+      if (wa == 0.0 && !sa.vertex_awake(at.a.index)) scratch_[at.d.surface_a].wake_request[at.a.index / Surface::kSleepBlock] = 1;
+      if (wb == 0.0 && xb && !surfaces_[at.d.surface_b]->vertex_awake(at.b.index)) {
+        scratch_[at.d.surface_b].wake_request[at.b.index / Surface::kSleepBlock] = 1;
+      }
+    }
     // Zero-length spring: C = pb − pa (vector); its multiplier over h² is the force it carries.
     const double kh2 = at.d.stiffness_un_per_mm * h2;
     Vec3 dl = (pb - xa) * kh2;
@@ -117,11 +138,10 @@ void TissueWorld::project_wall() {
     if (!s.contained_by_globe()) continue;
     auto view = s.solver_view();
     auto& touched = scratch_[static_cast<std::size_t>(&sp - surfaces_.data())].wall_touched;
-    const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
-    for (std::uint32_t v = 0; v < n; ++v) {
-      if (view.inverse_mass[v] == 0.0) continue;  // dead and anchored vertices have w = 0
+    for_each_awake_vertex(s, [&](std::uint32_t v) {
+      if (view.inverse_mass[v] == 0.0) return;  // dead and anchored vertices have w = 0
       if (wall_.project_inside(view.x[v], offset)) touched[v] = 1;
-    }
+    });
   }
 }
 

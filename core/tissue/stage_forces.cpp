@@ -6,13 +6,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/tissue/awake_vertices.hpp"
 #include "core/tissue/tissue_world.hpp"
 
 namespace vitreo::core {
 
 namespace {
 // Over this distance from the wall its reaction fades in (see below).
-constexpr double kContactBand_mm = 2e-2;
+constexpr double kContactBand_mm = 1e-3;
 }  // namespace
 
 void TissueWorld::compute_external_accelerations(double h) {
@@ -29,8 +30,23 @@ void TissueWorld::compute_external_accelerations(double h) {
     const double drag = s.material().drag_pa_s_per_mm;
     const double settling_damping = settings_.settling_damping_per_s;
 
+    // A block that fell asleep since the last step becomes immovable to its awake neighbours.
+    for (std::uint32_t b = 0; b < s.block_count(); ++b) {
+      const bool awake = s.block_awake(b);
+      if (!awake && sc.block_was_awake[b]) {
+        const std::uint32_t end = std::min(n, (b + 1) * Surface::kSleepBlock);
+        for (std::uint32_t v = b * Surface::kSleepBlock; v < end; ++v) {
+          sc.effective_inverse_mass[v] = 0.0;
+          sc.acceleration[v] = Vec3::Zero();
+          sc.contact_load[v] = 0.0;
+          sc.previous[v] = view.x[v];  // at rest: no motion for the spring dashpots to see
+        }
+      }
+      sc.block_was_awake[b] = awake ? 1 : 0;
+    }
+
     // Forces first (µN), converted to accelerations at the end.
-    for (std::uint32_t v = 0; v < n; ++v) sc.acceleration[v] = Vec3::Zero();
+    for_each_awake_vertex(s, [&](std::uint32_t v) { sc.acceleration[v] = Vec3::Zero(); });
 
     // Intraocular pressure presses the retina outward onto the choroid. It is applied along the
     // ray from the globe centre, on each vertex's share of the current (stretched) area: directed
@@ -39,15 +55,14 @@ void TissueWorld::compute_external_accelerations(double h) {
     // the normal pressure; tests/core check it against Laplace's law.)
     const bool pressurised = s.pressurised() && env.apply_pressure && env.intraocular_pressure_pa > 0.0;
     if (pressurised) {
-      for (std::uint32_t v = 0; v < n; ++v) sc.current_area[v] = 0.0;
-      for (std::uint32_t t = 0; t < view.tri_v.size(); ++t) {
-        if (!view.tri_alive[t]) continue;
-        const auto [a, b, c] = view.tri_v[t];
-        const double third = (view.x[b] - view.x[a]).cross(view.x[c] - view.x[a]).norm() / 6.0;
-        sc.current_area[a] += third;
-        sc.current_area[b] += third;
-        sc.current_area[c] += third;
-      }
+      for_each_awake_vertex(s, [&](std::uint32_t v) {
+        double area = 0.0;
+        s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+          const auto [a, b, c] = view.tri_v[t];
+          area += (view.x[b] - view.x[a]).cross(view.x[c] - view.x[a]).norm();
+        });
+        sc.current_area[v] = area / 6.0;
+      });
     }
 
     for (const auto& lf : local_forces_) {
@@ -55,7 +70,7 @@ void TissueWorld::compute_external_accelerations(double h) {
       const double p = lf.d.pressure_pa * lf.d.scale;
       for (std::size_t i = 0; i < lf.d.vertices.size(); ++i) {
         const std::uint32_t v = lf.d.vertices[i];
-        if (!view.vertex_alive[v]) continue;  // removed by the vitrector since
+        if (!view.vertex_alive[v] || !s.vertex_awake(v)) continue;  // removed since, or asleep
         const Vec3 toward = lf.d.toward_point_mm - view.x[v];
         const double dist = toward.norm();
         if (!(dist > 1e-9)) continue;
@@ -67,13 +82,13 @@ void TissueWorld::compute_external_accelerations(double h) {
     const bool walled = s.contained_by_globe();
     const double added_per_area = env.fluid_density_g_per_mm3 * s.material().entrained_fluid_mm;
     const double mu = settings_.wall_friction;
-    for (std::uint32_t v = 0; v < n; ++v) {
+    for_each_awake_vertex(s, [&](std::uint32_t v) {
       if (!view.vertex_alive[v] || view.inverse_mass[v] == 0.0) {
         sc.acceleration[v] = Vec3::Zero();
         sc.effective_inverse_mass[v] = 0.0;
         sc.drag_rate[v] = 0.0;
         sc.contact_load[v] = 0.0;
-        continue;
+        return;
       }
       // Inertia = own mass + entrained fluid (none under gas); weight acts on the own mass only.
       const bool in_gas = any_gas && view.x[v].z() > env.fluid_level_z_mm;
@@ -111,7 +126,7 @@ void TissueWorld::compute_external_accelerations(double h) {
         }
       }
       sc.acceleration[v] = a;
-    }
+    });
   }
 }
 

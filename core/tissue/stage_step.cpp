@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/tissue/awake_vertices.hpp"
 #include "core/tissue/tissue_world.hpp"
 
 namespace vitreo::core {
@@ -30,15 +31,12 @@ void TissueWorld::restore_rollback() {
 
 void TissueWorld::integrate_and_predict(double h) {
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    const Surface& s = *surfaces_[si];
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
-    const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
-    for (std::uint32_t v = 0; v < n; ++v) {
+    for_each_awake_vertex(s, [&](std::uint32_t v) {
       sc.previous[v] = view.x[v];
-      if (view.inverse_mass[v] == 0.0) continue;
-      // Implicit Euler with drag: (m + h c) v' = m v + h f, i.e. v' = (v + h a) / (1 + h c/m). It
-      // damps any rate without reversing the velocity and gives the right terminal speed; the
-      // constraints then use the matching effective mass (see Scratch::effective_inverse_mass).
+      if (view.inverse_mass[v] == 0.0) return;
       if (sc.contact_load[v] > 0.0) {
         // Lying on the wall: no velocity into it (an inelastic contact), and Coulomb friction
         // takes up to μ·load·h of the sliding speed each substep, so attached retina stays put.
@@ -49,9 +47,12 @@ void TissueWorld::integrate_and_predict(double h) {
         const double stop = settings_.wall_friction * sc.contact_load[v] * h;
         view.v[v] *= vt > stop ? 1.0 - stop / vt : 0.0;
       }
+      // Implicit Euler with drag: (m + h c) v' = m v + h f, i.e. v' = (v + h a) / (1 + h c/m). It
+      // damps any rate without reversing the velocity and gives the right terminal speed; the
+      // constraints then use the matching effective mass (see Scratch::effective_inverse_mass).
       view.v[v] = (view.v[v] + h * sc.acceleration[v]) / (1.0 + h * sc.drag_rate[v]);
       view.x[v] += h * view.v[v];
-    }
+    });
   }
 }
 
@@ -59,11 +60,12 @@ bool TissueWorld::update_velocities(double h) {
   const double inv_h = 1.0 / h;
   double checksum = 0.0;  // NaN or infinity anywhere propagates into the sum
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    const Surface& s = *surfaces_[si];
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
-    const std::uint32_t n = static_cast<std::uint32_t>(view.x.size());
-    for (std::uint32_t v = 0; v < n; ++v) {
-      if (view.inverse_mass[v] == 0.0) continue;
+    std::fill(sc.block_max_speed2.begin(), sc.block_max_speed2.end(), 0.0);
+    for_each_awake_vertex(s, [&](std::uint32_t v) {
+      if (view.inverse_mass[v] == 0.0) return;
       view.v[v] = (view.x[v] - sc.previous[v]) * inv_h;
       if (sc.wall_touched[v]) {
         sc.wall_touched[v] = 0;
@@ -72,9 +74,75 @@ bool TissueWorld::update_velocities(double h) {
         if (vn > 0.0) view.v[v] -= vn * normal;
       }
       checksum += view.x[v].x() + view.x[v].y() + view.x[v].z() + view.v[v].x() + view.v[v].y() + view.v[v].z();
-    }
+      double& m = sc.block_max_speed2[v / Surface::kSleepBlock];
+      m = std::max(m, view.v[v].squaredNorm());
+    });
   }
   return std::isfinite(checksum);
+}
+
+void TissueWorld::prepare_sleep_groups() {
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    const Surface& s = *surfaces_[si];
+    Scratch& sc = scratch_[si];
+    const std::uint32_t blocks = s.block_count();
+    if (sc.groups_version != s.topology_version()) {
+      // Counting sort of live springs by the block of their lower vertex (mesh order inside).
+      std::fill(sc.group_begin.begin(), sc.group_begin.end(), 0u);
+      for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+        if (!s.edge_alive(e)) continue;
+        const auto ev = s.edge_vertices(e);
+        ++sc.group_begin[std::min(ev[0], ev[1]) / Surface::kSleepBlock + 1];
+      }
+      for (std::uint32_t g = 0; g < blocks; ++g) sc.group_begin[g + 1] += sc.group_begin[g];
+      // Fill using partner_begin as a temporary cursor.
+      std::copy(sc.group_begin.begin(), sc.group_begin.end(), sc.partner_begin.begin());
+      for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+        if (!s.edge_alive(e)) continue;
+        const auto ev = s.edge_vertices(e);
+        sc.group_edges[sc.partner_begin[std::min(ev[0], ev[1]) / Surface::kSleepBlock]++] = e;
+      }
+      // The other blocks each group reaches, without duplicates.
+      std::fill(sc.mark.begin(), sc.mark.end(), 0u);
+      std::uint32_t n = 0;
+      for (std::uint32_t g = 0; g < blocks; ++g) {
+        sc.partner_begin[g] = n;
+        for (std::uint32_t i = sc.group_begin[g]; i < sc.group_begin[g + 1]; ++i) {
+          const auto ev = s.edge_vertices(sc.group_edges[i]);
+          const std::uint32_t other = std::max(ev[0], ev[1]) / Surface::kSleepBlock;
+          if (other != g && sc.mark[other] != g + 1 && n < sc.partners.size()) {
+            sc.mark[other] = g + 1;
+            sc.partners[n++] = other;
+          }
+        }
+      }
+      sc.partner_begin[blocks] = n;
+      sc.groups_version = s.topology_version();
+    }
+    for (std::uint32_t g = 0; g < blocks; ++g) {
+      bool active = s.block_awake(g);
+      for (std::uint32_t i = sc.partner_begin[g]; i < sc.partner_begin[g + 1] && !active; ++i) {
+        active = s.block_awake(sc.partners[i]);
+      }
+      sc.group_active[g] = active ? 1 : 0;
+    }
+  }
+}
+
+void TissueWorld::finish_sleep() {
+  const double sleep2 = settings_.sleep_speed_mm_s * settings_.sleep_speed_mm_s;
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    Surface& s = *surfaces_[si];
+    Scratch& sc = scratch_[si];
+    if (settings_.sleeping) {
+      s.update_sleep(sc.block_max_speed2, sleep2, static_cast<std::uint32_t>(settings_.sleep_after_steps));
+    }
+    for (std::uint32_t b = 0; b < s.block_count(); ++b) {
+      if (!sc.wake_request[b]) continue;
+      sc.wake_request[b] = 0;
+      if (b * Surface::kSleepBlock < s.vertex_slots()) s.wake_vertex(b * Surface::kSleepBlock);
+    }
+  }
 }
 
 void TissueWorld::break_attachments() {
@@ -95,23 +163,22 @@ void TissueWorld::break_attachments() {
 
 void TissueWorld::find_overstrained() {
   // Measured on the final positions of the step: inside the sweep a spring's length is still
-  // changing as its neighbours are projected after it.
+  // changing as its neighbours are projected after it. Springs among sleeping vertices do not
+  // change, so only the active groups are scanned.
   for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     Surface& s = *surfaces_[si];
     const double tear = s.material().tear_strain;
     if (!std::isfinite(tear)) continue;
     auto view = s.solver_view();
     const double f2 = (1.0 + tear) * (1.0 + tear);
-    const std::uint32_t ne = static_cast<std::uint32_t>(view.edge_v.size());
-    for (std::uint32_t e = 0; e < ne; ++e) {
-      if (!view.edge_alive[e]) continue;
+    for_each_active_edge(si, [&](std::uint32_t e) {
       const auto [a, b] = view.edge_v[e];
       const double len2 = (view.x[b] - view.x[a]).squaredNorm();
       const double limit2 = f2 * view.rest_len[e] * view.rest_len[e];
       if (len2 > limit2 && tear_candidates_.size() < tear_candidates_.capacity()) {
         tear_candidates_.push_back({si, e, std::sqrt(len2) / view.rest_len[e] - 1.0});
       }
-    }
+    });
   }
 }
 
@@ -156,6 +223,7 @@ StepReport TissueWorld::step(double dt_s) {
   }
   for (auto& at : attachments_) at.peak_force_un = 0.0;
 
+  prepare_sleep_groups();
   save_rollback();
   const int substeps = settings_.substeps;
   const double h = dt_s / substeps;
@@ -191,6 +259,7 @@ StepReport TissueWorld::step(double dt_s) {
   for (auto& sp : surfaces_) sp->apply_plasticity(dt_s);
   break_attachments();
   tear_overstrained();
+  finish_sleep();
   for (const auto& e : events_) {
     if (e.kind == TissueEventKind::kTear) ++report.tears;
     if (e.kind == TissueEventKind::kAttachmentBroken) ++report.attachments_broken;

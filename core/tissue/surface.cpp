@@ -44,6 +44,8 @@ Surface::Surface(const SurfaceDescription& d)
               edge_is_line_, edge_generation_, free_edges_);
   reserve_all(tcap, tri_v_, tri_e_, tri_rest_area_, tri_alive_, tri_generation_, free_triangles_);
   next_corner_.reserve(3 * static_cast<std::size_t>(tcap));
+  block_awake_.assign((vcap + kSleepBlock - 1) / kSleepBlock, 1);
+  block_quiet_steps_.assign(block_awake_.size(), 0);
 
   for (std::size_t i = 0; i < nv; ++i) {
     require_finite(mesh.positions[i], "surface '" + material_.name + "': vertex position");
@@ -129,6 +131,8 @@ std::uint32_t Surface::allocate_vertex() {
   fixed_[v] = 0;
   first_corner_[v] = kNone;
   ++live_vertices_;
+  ++topology_version_;
+  if (!block_awake_.empty()) wake_vertex(v);
   return v;
 }
 
@@ -154,6 +158,7 @@ std::uint32_t Surface::allocate_edge() {
   edge_alive_[e] = 1;
   edge_is_line_[e] = 0;
   ++live_edges_;
+  ++topology_version_;
   return e;
 }
 
@@ -177,6 +182,9 @@ std::uint32_t Surface::allocate_triangle() {
 }
 
 void Surface::free_edge(std::uint32_t e) {
+  ++topology_version_;
+  wake_vertex(edge_v_[e][0]);
+  wake_vertex(edge_v_[e][1]);
   edge_alive_[e] = 0;
   stiffness_[e] = 0.0;
   ++edge_generation_[e];
@@ -314,6 +322,7 @@ Status Surface::set_fixed(VertexId id, bool fixed) {
   fixed_[id.index] = fixed ? 1 : 0;
   if (fixed) v_[id.index] = Vec3::Zero();
   update_vertex_mass(id.index);
+  wake_vertex(id.index);
   return Status::ok();
 }
 
@@ -322,6 +331,7 @@ Status Surface::set_fixed_position(VertexId id, const Vec3& p) {
   if (!fixed_[id.index]) return Status::error("set_fixed_position: vertex is not fixed");
   if (!is_finite(p)) return Status::error("set_fixed_position: non-finite position");
   x_[id.index] = p;
+  wake_vertex(id.index);
   return Status::ok();
 }
 
@@ -329,6 +339,7 @@ Status Surface::set_position(VertexId id, const Vec3& p) {
   if (!is_current(id)) return Status::error("set_position: stale or invalid vertex handle");
   if (!is_finite(p)) return Status::error("set_position: non-finite position");
   x_[id.index] = p;
+  wake_vertex(id.index);
   return Status::ok();
 }
 
@@ -336,6 +347,7 @@ Status Surface::set_velocity(VertexId id, const Vec3& vel) {
   if (!is_current(id)) return Status::error("set_velocity: stale or invalid vertex handle");
   if (!is_finite(vel)) return Status::error("set_velocity: non-finite velocity");
   v_[id.index] = fixed_[id.index] ? Vec3::Zero() : vel;
+  wake_vertex(id.index);
   return Status::ok();
 }
 
@@ -347,6 +359,7 @@ Status Surface::set_surface_traction(double scale) {
   for (std::uint32_t e = 0; e < edge_slots(); ++e) {
     if (edge_alive_[e]) refresh_rest(e);
   }
+  wake_all();
   return Status::ok();
 }
 
@@ -357,6 +370,8 @@ Status Surface::set_edge_traction(EdgeId id, double scale) {
   }
   edge_traction_[id.index] = scale;
   refresh_rest(id.index);
+  wake_vertex(edge_v_[id.index][0]);
+  wake_vertex(edge_v_[id.index][1]);
   return Status::ok();
 }
 
@@ -379,6 +394,29 @@ void Surface::apply_plasticity(double dt_s) {
     base_rest_vec_[e] += alpha * excess;
     refresh_rest(e);
   }
+}
+
+void Surface::wake_all() {
+  std::fill(block_awake_.begin(), block_awake_.end(), std::uint8_t{1});
+  std::fill(block_quiet_steps_.begin(), block_quiet_steps_.end(), std::uint16_t{0});
+}
+
+void Surface::update_sleep(std::span<const double> block_max_speed2, double sleep_speed2, std::uint32_t steps_to_sleep) {
+  for (std::uint32_t b = 0; b < block_count(); ++b) {
+    if (!block_awake_[b]) continue;
+    if (block_max_speed2[b] >= sleep_speed2) {
+      block_quiet_steps_[b] = 0;
+      continue;
+    }
+    if (++block_quiet_steps_[b] < steps_to_sleep) continue;
+    block_awake_[b] = 0;
+    const std::uint32_t end = std::min(vertex_slots(), (b + 1) * kSleepBlock);
+    for (std::uint32_t v = b * kSleepBlock; v < end; ++v) v_[v] = Vec3::Zero();
+  }
+}
+
+std::uint32_t Surface::awake_block_count() const {
+  return static_cast<std::uint32_t>(std::count(block_awake_.begin(), block_awake_.end(), std::uint8_t{1}));
 }
 
 Surface::SolverView Surface::solver_view() {

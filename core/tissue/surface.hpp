@@ -144,6 +144,27 @@ class Surface {
   };
   TearResult tear_edge(EdgeId e);
 
+  // ---- Sleeping ------------------------------------------------------------------------------
+  // Vertices are grouped in blocks of kSleepBlock consecutive slots (mesh order, so a block is a
+  // compact strip of surface). A block at rest for a while sleeps: the solver skips it and its
+  // neighbours see its vertices as anchored, until something wakes it (a pull from an awake
+  // neighbour, a changed force, an instrument, a topology change). Retina lying on the choroid is
+  // most of the eye and at rest most of the time; this is what lets a 1 ms step afford it.
+  static constexpr std::uint32_t kSleepBlock = 64;
+  std::uint32_t block_count() const { return static_cast<std::uint32_t>(block_awake_.size()); }
+  bool block_awake(std::uint32_t b) const { return block_awake_[b] != 0; }
+  bool vertex_awake(std::uint32_t v) const { return block_awake_[v / kSleepBlock] != 0; }
+  void wake_vertex(std::uint32_t v) {
+    block_awake_[v / kSleepBlock] = 1;
+    block_quiet_steps_[v / kSleepBlock] = 0;
+  }
+  void wake_all();
+  // Called by the solver at the end of a step with each block's largest squared speed.
+  void update_sleep(std::span<const double> block_max_speed2, double sleep_speed2, std::uint32_t steps_to_sleep);
+  std::uint32_t awake_block_count() const;
+  // Incremented by every topology change, so solver-side indexes know when to rebuild.
+  std::uint64_t topology_version() const { return topology_version_; }
+
   // ---- Solver access -------------------------------------------------------------------------
   // The solver works on the raw arrays; these are for it and for the topology code only.
   struct SolverView;
@@ -201,6 +222,10 @@ class Surface {
   std::vector<std::uint32_t> tri_generation_, free_triangles_;
   std::uint32_t live_triangles_ = 0;
 
+  // Sleeping.
+  std::vector<std::uint8_t> block_awake_;
+  std::vector<std::uint16_t> block_quiet_steps_;
+  std::uint64_t topology_version_ = 0;
 };
 
 // Raw arrays handed to the solver (no copies). Valid until the next topology change.

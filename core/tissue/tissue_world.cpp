@@ -30,6 +30,9 @@ void SolverSettings::validate() const {
   require_range(wall_offset_mm, 0.0, 5.0, "solver: wall_offset_mm");
   require_range(settling_damping_per_s, 0.0, 1e4, "solver: settling_damping_per_s");
   require_range(wall_friction, 0.0, 10.0, "solver: wall_friction");
+  require_range(sleep_speed_mm_s, 0.0, 100.0, "solver: sleep_speed_mm_s");
+  if (sleep_after_steps < 1 || sleep_after_steps > 60000) throw InvalidArgument("solver: sleep_after_steps must be in [1, 60000]");
+  require_range(wake_strain, 1e-6, 1.0, "solver: wake_strain");
 }
 
 TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings settings)
@@ -53,6 +56,16 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.current_area.resize(cap);
   s.contact_load.resize(cap);
   s.wall_touched.resize(cap);
+  const std::size_t blocks = surface->block_count();
+  s.block_was_awake.assign(blocks, 0);
+  s.wake_request.assign(blocks, 0);
+  s.block_max_speed2.assign(blocks, 0.0);
+  s.group_begin.assign(blocks + 1, 0);
+  s.group_edges.assign(surface->edge_capacity(), 0);
+  s.partner_begin.assign(blocks + 1, 0);
+  s.partners.assign(surface->edge_capacity() + blocks, 0);
+  s.mark.assign(blocks, 0);
+  s.group_active.assign(blocks, 1);
   s.lambda_distance.resize(surface->edge_capacity());
   s.lambda_direction.resize(surface->edge_capacity());
   surfaces_.push_back(std::move(surface));
@@ -106,7 +119,35 @@ Status TissueWorld::set_environment(const Environment& environment) {
     return Status::error(e.what());
   }
   environment_ = environment;
+  wake_all();
   return Status::ok();
+}
+
+void TissueWorld::wake_all() {
+  for (auto& sp : surfaces_) sp->wake_all();
+}
+
+void TissueWorld::wake_sphere(const Vec3& center, double radius) {
+  if (!is_finite(center) || !std::isfinite(radius)) return;
+  const double r2 = radius * radius;
+  for (auto& sp : surfaces_) {
+    Surface& s = *sp;
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      if (s.vertex_alive(v) && !s.vertex_awake(v) && (s.position(v) - center).squaredNorm() <= r2) s.wake_vertex(v);
+    }
+  }
+}
+
+std::uint32_t TissueWorld::awake_blocks() const {
+  std::uint32_t n = 0;
+  for (const auto& sp : surfaces_) n += sp->awake_block_count();
+  return n;
+}
+
+std::uint32_t TissueWorld::total_blocks() const {
+  std::uint32_t n = 0;
+  for (const auto& sp : surfaces_) n += sp->block_count();
+  return n;
 }
 
 Status TissueWorld::set_local_force_scale(std::uint32_t force, double scale) {
@@ -114,7 +155,14 @@ Status TissueWorld::set_local_force_scale(std::uint32_t force, double scale) {
   if (!std::isfinite(scale) || scale < 0.0 || scale > 1.0) {
     return Status::error("set_local_force_scale: scale must be finite and in [0, 1]");
   }
-  local_forces_[force].d.scale = scale;
+  auto& f = local_forces_[force].d;
+  if (f.scale != scale) {
+    Surface& s = *surfaces_[f.surface];
+    for (auto v : f.vertices) {
+      if (s.vertex_alive(v)) s.wake_vertex(v);
+    }
+  }
+  f.scale = scale;
   return Status::ok();
 }
 

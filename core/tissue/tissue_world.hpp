@@ -48,6 +48,13 @@ struct SolverSettings {
   // Mass-proportional velocity damping (1/s) on top of fluid drag: used to settle a case to
   // equilibrium on load and by tests; 0 during surgery.
   double settling_damping_per_s = 0.0;
+  // Sleeping (see Surface::kSleepBlock): a block whose vertices all stay below sleep_speed for
+  // sleep_after_steps consecutive steps stops being simulated until something wakes it.
+  bool sleeping = true;
+  double sleep_speed_mm_s = 0.2;
+  int sleep_after_steps = 200;
+  // A sleeping vertex wakes when an awake neighbour's spring to it is strained by more than this.
+  double wake_strain = 0.01;
   // Friction between tissue and the globe wall (retina on the pigment epithelium): a vertex in
   // contact stays put while the tangential load is below this fraction of the normal load.
   double wall_friction = 0.5;
@@ -144,6 +151,13 @@ class TissueWorld {
   Energy energy() const;
   std::uint64_t state_hash() const;
 
+  // Wakes every sleeping vertex within radius of a point (instruments call this where they act).
+  void wake_sphere(const Vec3& center_mm, double radius_mm);
+  void wake_all();
+  // Awake vertex blocks over all surfaces (for diagnostics and benchmarks).
+  std::uint32_t awake_blocks() const;
+  std::uint32_t total_blocks() const;
+
  private:
   struct Attachment {
     AttachmentDescription d;
@@ -170,6 +184,17 @@ class TissueWorld {
     // removed (an inelastic contact, as in the velocity pass of Müller et al. 2020) so it cannot
     // bounce between wall and springs from one substep to the next.
     std::vector<std::uint8_t> wall_touched;
+
+    // Sleeping bookkeeping, per vertex block.
+    std::vector<std::uint8_t> block_was_awake;  // awake during the previous step
+    std::vector<std::uint8_t> wake_request;     // set during a step, applied at its end
+    std::vector<double> block_max_speed2;
+    // Springs grouped by the block of their lower vertex, with the other blocks each group
+    // reaches, so a sweep can skip whole groups that touch only sleeping blocks. Rebuilt (without
+    // allocating) whenever the surface's topology changes.
+    std::vector<std::uint32_t> group_begin, group_edges, partner_begin, partners, mark;
+    std::vector<std::uint8_t> group_active;
+    std::uint64_t groups_version = ~std::uint64_t{0};
     // Constraint multipliers accumulated over the iterations of one substep (only with
     // iterations > 1; a single iteration starts every constraint from zero).
     std::vector<double> lambda_distance;
@@ -191,6 +216,10 @@ class TissueWorld {
   void break_attachments();
   void find_overstrained();
   void tear_overstrained();
+  void prepare_sleep_groups();
+  void finish_sleep();
+  template <class F>
+  void for_each_active_edge(std::uint32_t si, F&& f);
   void save_rollback();
   void restore_rollback();
 
@@ -206,5 +235,17 @@ class TissueWorld {
   std::uint64_t step_count_ = 0;
   double time_s_ = 0.0;
 };
+
+// Calls f(edge) for every spring in a group that touches an awake block (prepare_sleep_groups()
+// decides which), in a fixed order: mesh order within a group, groups in block order.
+template <class F>
+void TissueWorld::for_each_active_edge(std::uint32_t si, F&& f) {
+  const Scratch& sc = scratch_[si];
+  const std::uint32_t groups = static_cast<std::uint32_t>(sc.group_active.size());
+  for (std::uint32_t g = 0; g < groups; ++g) {
+    if (!sc.group_active[g]) continue;
+    for (std::uint32_t i = sc.group_begin[g]; i < sc.group_begin[g + 1]; ++i) f(sc.group_edges[i]);
+  }
+}
 
 }  // namespace vitreo::core

@@ -19,7 +19,7 @@ struct Options {
   int steps = 3000;
   double dt_s = 1e-3;
   int retina_vertices = 20000;
-  int membrane_vertices = 2000;
+  bool membrane = true;
   int substeps = 2;
 };
 
@@ -39,8 +39,7 @@ int main(int argc, char** argv) {
   app.add_option("--steps", opt.steps, "number of physics steps to run")->check(CLI::Range(1, 100'000'000));
   app.add_option("--dt", opt.dt_s, "physics step in seconds")->check(CLI::Range(1e-5, 0.02));
   app.add_option("--retina-vertices", opt.retina_vertices, "retina mesh resolution")->check(CLI::Range(100, 2'000'000));
-  app.add_option("--membrane-vertices", opt.membrane_vertices, "epiretinal membrane resolution (0: none)")
-      ->check(CLI::Range(0, 500'000));
+  app.add_flag("!--no-membrane", opt.membrane, "leave out the epiretinal membrane");
   app.add_option("--substeps", opt.substeps, "solver substeps per step")->check(CLI::Range(1, 64));
   try {
     app.parse(argc, argv);
@@ -50,7 +49,7 @@ int main(int argc, char** argv) {
 
   vitreo::core::RetinaCapOptions scene_options;
   scene_options.retina_vertices = opt.retina_vertices;
-  scene_options.membrane_vertices = opt.membrane_vertices;
+  scene_options.membrane = opt.membrane;
   scene_options.solver.substeps = opt.substeps;
   auto build_start = std::chrono::steady_clock::now();
   std::optional<vitreo::core::RetinaCapScene> scene;

@@ -28,7 +28,7 @@ void report_quantiles(benchmark::State& state, std::vector<double>& samples_us, 
 void BM_TissueStep(benchmark::State& state) {
   RetinaCapOptions o;
   o.retina_vertices = static_cast<int>(state.range(0));
-  o.membrane_vertices = o.retina_vertices / 10;
+  o.membrane = true;
   auto scene = build_retina_cap(o);
   TissueWorld& world = scene.world;
   for (int i = 0; i < 100; ++i) world.step(1e-3);  // warm-up: the detachment starts to lift
