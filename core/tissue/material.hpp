@@ -28,11 +28,13 @@ struct TissueMaterial {
   // stretch, Michels et al. 1990). Infinity disables tearing.
   double tear_strain = 0.45;
 
-  // Drag from the surrounding fluid, per unit area (µN·s/mm³ = Pa·s/mm): damps absolute motion so
-  // tissue released in vitreous settles instead of oscillating. A 0.25 mm sheet weighs so little
-  // that the fluid around it, not its own inertia, sets how fast it moves: with 5 Pa·s/mm a net
-  // 600 Pa detachment pressure lifts the retina at ~0.1 m/s rather than flinging it.
-  double drag_pa_s_per_mm = 5.0;
+  // Drag from the surrounding gel and fluid, per unit area (µN·s/mm³ = Pa·s/mm): damps absolute
+  // motion so tissue released in vitreous settles instead of oscillating. A 0.25 mm sheet weighs so
+  // little that the medium, not its own inertia, sets how fast it moves: with 20 Pa·s/mm a net
+  // 150 Pa detachment pressure lifts the retina at ~7 mm/s. It also adds h·c to the effective mass
+  // of each substep, which keeps the one-iteration solver close to the nominal stiffness on fine
+  // meshes (see README, "Solver accuracy").
+  double drag_pa_s_per_mm = 20.0;
 
   // Internal (viscoelastic) damping of the springs, as a time constant: each spring carries a
   // dashpot of coefficient τ·k in parallel (stiffness-proportional Rayleigh damping). Soft tissue is
