@@ -1,0 +1,77 @@
+#include "rig/runtime/thread_harness.hpp"
+
+#include <pthread.h>
+
+#include <stdexcept>
+#include <utility>
+
+namespace vitreo::runtime {
+
+ThreadHarness::ThreadHarness(Clock& physics_clock, HarnessConfig config, FixedStepLoop::StepFn physics_step)
+    : config_(config), loop_(physics_clock, config.loop, std::move(physics_step)) {}
+
+ThreadHarness::~ThreadHarness() { stop(); }
+
+void ThreadHarness::add_service(std::string name, std::chrono::nanoseconds period, std::function<void()> fn) {
+  if (started_) throw std::logic_error("ThreadHarness: add services before start()");
+  auto s = std::make_unique<Service>();
+  s->name = std::move(name);
+  s->period = period;
+  s->fn = std::move(fn);
+  services_.push_back(std::move(s));
+}
+
+void ThreadHarness::start() {
+  if (started_) throw std::logic_error("ThreadHarness: started twice");
+  started_ = true;
+  physics_ = std::thread([this] {
+    pthread_setname_np(pthread_self(), "vitreo-physics");
+    if (config_.physics_realtime) rt_outcome_ = apply_realtime(config_.physics_rt);
+    loop_.run(config_.max_steps);
+    physics_done_.store(true, std::memory_order_release);
+  });
+  for (auto& sp : services_) {
+    Service* s = sp.get();
+    s->thread = std::thread([this, s] {
+      pthread_setname_np(pthread_self(), s->name.substr(0, 15).c_str());
+      auto next = std::chrono::steady_clock::now();
+      std::unique_lock lock(mu_);
+      while (!services_stop_) {
+        lock.unlock();
+        s->fn();
+        ++s->calls;
+        lock.lock();
+        next += s->period;
+        cv_.wait_until(lock, next, [this] { return services_stop_; });
+      }
+      lock.unlock();
+      s->fn();  // final drain after physics has stopped
+      ++s->calls;
+    });
+  }
+}
+
+void ThreadHarness::join_physics() {
+  if (physics_.joinable()) physics_.join();
+}
+
+void ThreadHarness::wait_physics() { join_physics(); }
+
+bool ThreadHarness::physics_done() const noexcept { return physics_done_.load(std::memory_order_acquire); }
+
+void ThreadHarness::stop() {
+  if (!started_ || stopped_) return;
+  stopped_ = true;
+  loop_.request_stop();
+  join_physics();
+  {
+    std::lock_guard lock(mu_);
+    services_stop_ = true;
+  }
+  cv_.notify_all();
+  for (auto& s : services_) {
+    if (s->thread.joinable()) s->thread.join();
+  }
+}
+
+}  // namespace vitreo::runtime
