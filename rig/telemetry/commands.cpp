@@ -1,0 +1,125 @@
+#include "rig/telemetry/commands.hpp"
+
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+#include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/items.hpp"
+#include "rig/telemetry/publisher.hpp"
+#include "vitreo_lcm/command_ack_t.hpp"
+
+namespace vitreo::telemetry {
+
+const char* command_name(std::int8_t code) noexcept {
+  switch (static_cast<CommandCode>(code)) {
+    case CommandCode::NextCase: return "next_case";
+    case CommandCode::PreviousCase: return "previous_case";
+    case CommandCode::Pause: return "pause";
+    case CommandCode::Resume: return "resume";
+    case CommandCode::Reset: return "reset";
+    case CommandCode::SaveSnapshot: return "save_snapshot";
+    case CommandCode::ToggleWireframe: return "toggle_wireframe";
+    case CommandCode::ToggleLabels: return "toggle_labels";
+    case CommandCode::Zoom: return "zoom";
+  }
+  return "unknown";
+}
+
+namespace {
+bool valid_snapshot_name(const std::string& s) {
+  if (s.empty() || s.size() > 64 || s.front() == '.') return false;
+  for (char c : s) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                    c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+}  // namespace
+
+Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const CommandContext& ctx) {
+  auto refuse = [](std::string why) { return Verdict{false, std::move(why)}; };
+  switch (static_cast<CommandCode>(cmd.command)) {
+    case CommandCode::NextCase:
+      if (ctx.case_index + 1 >= ctx.case_count)
+        return refuse("already at the last case (" + std::to_string(ctx.case_index + 1) + " of " +
+                      std::to_string(ctx.case_count) + ")");
+      break;
+    case CommandCode::PreviousCase:
+      if (ctx.case_index <= 0) return refuse("already at the first case");
+      break;
+    case CommandCode::Pause:
+      if (ctx.paused) return refuse("physics is already paused");
+      break;
+    case CommandCode::Resume:
+      if (!ctx.paused) return refuse("physics is not paused");
+      break;
+    case CommandCode::SaveSnapshot:
+      if (!valid_snapshot_name(cmd.arg))
+        return refuse("snapshot name must be 1-64 characters of [A-Za-z0-9._-], not starting with '.'");
+      break;
+    case CommandCode::Zoom:
+      if (!std::isfinite(cmd.value)) return refuse("zoom value is not a finite number");
+      if (cmd.value < ctx.zoom_min || cmd.value > ctx.zoom_max)
+        return refuse("zoom " + std::to_string(cmd.value) + " outside " + std::to_string(ctx.zoom_min) + ".." +
+                      std::to_string(ctx.zoom_max));
+      break;
+    case CommandCode::Reset:
+    case CommandCode::ToggleWireframe:
+    case CommandCode::ToggleLabels:
+      break;
+    default:
+      return refuse("unknown command code " + std::to_string(cmd.command));
+  }
+  return Verdict{true, {}};
+}
+
+CommandServer::CommandServer(lcm::LCM& lcm, std::size_t queue_capacity) : lcm_(lcm), queue_(queue_capacity) {
+  sub_ = lcm_.subscribe(kChanCommand, &CommandServer::on_command, this);
+}
+
+CommandServer::~CommandServer() {
+  if (sub_) lcm_.unsubscribe(sub_);
+}
+
+void CommandServer::on_command(const lcm::ReceiveBuffer*, const std::string&,
+                               const vitreo_lcm::operator_command_t* cmd) {
+  Verdict v;
+  auto last = last_seq_.find(cmd->source);
+  if (cmd->source.empty()) {
+    v = {false, "command has no source"};
+  } else if (last != last_seq_.end() && cmd->seq <= last->second) {
+    v = {false, "sequence " + std::to_string(cmd->seq) + " is not after " + std::to_string(last->second) +
+                    " from '" + cmd->source + "' (duplicate or reordered)"};
+  } else {
+    v = validate_command(*cmd, context_.read());
+  }
+  if (!cmd->source.empty() && (last == last_seq_.end() || cmd->seq > last->second)) last_seq_[cmd->source] = cmd->seq;
+
+  if (v.accepted) {
+    AcceptedCommand a;
+    a.code = static_cast<CommandCode>(cmd->command);
+    a.value = cmd->value;
+    copy_text(a.arg, cmd->arg);
+    a.seq = cmd->seq;
+    if (!queue_.try_push(a)) v = {false, "physics command queue is full"};
+  }
+  vitreo_lcm::command_ack_t ack;
+  ack.utime_us = wall_time_us();
+  ack.source = cmd->source;
+  ack.seq = cmd->seq;
+  ack.command = cmd->command;
+  ack.accepted = v.accepted;
+  ack.reason = v.reason;
+  lcm_.publish(kChanCommandAck, &ack);
+  if (v.accepted) {
+    ++accepted_;
+    spdlog::info("command {} #{} from '{}' accepted", command_name(cmd->command), cmd->seq, cmd->source);
+  } else {
+    ++refused_;
+    spdlog::warn("command {} #{} from '{}' refused: {}", command_name(cmd->command), cmd->seq, cmd->source, v.reason);
+  }
+}
+
+}  // namespace vitreo::telemetry
