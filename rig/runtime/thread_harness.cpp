@@ -1,9 +1,14 @@
 #include "rig/runtime/thread_harness.hpp"
 
 #include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <stdexcept>
 #include <utility>
+
+#include <spdlog/spdlog.h>
 
 namespace vitreo::runtime {
 
@@ -34,6 +39,12 @@ void ThreadHarness::start() {
     Service* s = sp.get();
     s->thread = std::thread([this, s] {
       pthread_setname_np(pthread_self(), s->name.substr(0, 15).c_str());
+      if (config_.service_nice != 0) {
+        // Linux nice values are per thread (PRIO_PROCESS with a thread id).
+        const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+        if (setpriority(PRIO_PROCESS, tid, config_.service_nice) != 0)
+          spdlog::warn("harness: cannot set nice {} on service '{}'", config_.service_nice, s->name);
+      }
       auto next = std::chrono::steady_clock::now();
       std::unique_lock lock(mu_);
       while (!services_stop_) {

@@ -25,6 +25,9 @@ struct HarnessConfig {
   bool physics_realtime = false;  // the rig turns this on; tests leave it off
   RealtimeConfig physics_rt;
   std::uint64_t max_steps = UINT64_MAX;  // physics stops by itself after this many steps
+  // Nice value for service threads. Lowering their priority needs no privilege, so even where
+  // SCHED_FIFO is refused the scheduler favours physics over a busy render or telemetry thread.
+  int service_nice = 10;
 };
 
 class ThreadHarness {
