@@ -7,10 +7,25 @@
 
 #include <cerrno>
 #include <cstring>
+#include <fstream>
+#include <string>
 
 #include <spdlog/spdlog.h>
 
 namespace vitreo::runtime {
+
+namespace {
+// Locked memory of this process in kB from /proc/self/status (-1 if unknown). mlockall's return
+// value alone is not trusted: sanitizer runtimes intercept it and return success without locking.
+long locked_kb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmLck:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+}  // namespace
 
 RealtimeOutcome apply_realtime(const RealtimeConfig& config) {
   RealtimeOutcome out;
@@ -30,7 +45,11 @@ RealtimeOutcome apply_realtime(const RealtimeConfig& config) {
   }
   if (config.lock_memory) {
     if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
-      out.memory_locked = true;
+      if (locked_kb() == 0) {
+        refuse("mlockall succeeded but VmLck is 0 (intercepted, e.g. by a sanitizer)", ENOTSUP);
+      } else {
+        out.memory_locked = true;
+      }
     } else {
       refuse("mlockall", errno);
     }

@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <fstream>
+#include <string>
 
 #include "rig/runtime/clock.hpp"
 #include "rig/runtime/fixed_step_loop.hpp"
@@ -25,6 +27,14 @@ int in_child(Fn fn) {
   int status = 0;
   if (waitpid(pid, &status, 0) != pid) return -1;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+long vm_locked_kb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmLck:", 0) == 0) return std::stol(line.substr(6));
+  return -1;
 }
 
 // Makes the child an ordinary unprivileged process: no real-time priority, no locked memory.
@@ -72,7 +82,7 @@ TEST(Realtime, ReportMatchesWhatTheKernelGranted) {
     RealtimeConfig cfg;
     cfg.sched_fifo = true;
     cfg.fifo_priority = 1;
-    cfg.lock_memory = false;
+    cfg.lock_memory = true;  // in this short-lived child only
     cfg.cpu = 0;
     const RealtimeOutcome out = apply_realtime(cfg);
     int policy = -1;
@@ -84,7 +94,8 @@ TEST(Realtime, ReportMatchesWhatTheKernelGranted) {
     pthread_getaffinity_np(pthread_self(), sizeof set, &set);
     const bool pinned = CPU_COUNT(&set) == 1 && CPU_ISSET(0, &set);
     if (out.affinity != pinned) return 21;
-    if (out.all_requested_applied() != (out.fifo && out.affinity && out.timer_slack)) return 22;
+    if (out.memory_locked != (vm_locked_kb() > 0)) return 22;
+    if (out.all_requested_applied() != (out.fifo && out.affinity && out.timer_slack && out.memory_locked)) return 23;
     return 0;
   });
   EXPECT_EQ(rc, 0) << "child failed at check " << rc;
