@@ -65,6 +65,7 @@ std::uint64_t FixedStepLoop::run(std::uint64_t max_steps) {
 
 LoopStats FixedStepLoop::stats() const {
   LoopStats s = counters_;
+  s.window_steps = step_hist_.count();
   s.step_p50_ns = step_hist_.quantile_ns(0.5);
   s.step_p99_ns = step_hist_.quantile_ns(0.99);
   s.step_max_ns = step_hist_.max_ns();

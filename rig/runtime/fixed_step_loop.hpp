@@ -34,7 +34,8 @@ struct LoopConfig {
 };
 
 struct LoopStats {
-  std::uint64_t steps = 0;
+  std::uint64_t steps = 0;          // cumulative, like the counters below
+  std::uint64_t window_steps = 0;   // steps in the histograms (since the last reset_histograms())
   std::uint64_t overruns = 0;       // steps whose duration exceeded the period
   std::uint64_t late_steps = 0;     // steps started >= one period after their deadline (caught up)
   std::uint64_t dropped_steps = 0;  // deadlines skipped by backlog drops

@@ -30,7 +30,7 @@ PhysicsTiming timing_item(const runtime::LoopStats& s, std::uint64_t step, std::
   t.overruns = static_cast<std::int64_t>(s.overruns);
   t.late_steps = static_cast<std::int64_t>(s.late_steps);
   t.dropped_steps = static_cast<std::int64_t>(s.dropped_steps);
-  t.window_steps = static_cast<std::int32_t>(s.steps);
+  t.window_steps = static_cast<std::int32_t>(s.window_steps);
   return t;
 }
 

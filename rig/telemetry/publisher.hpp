@@ -76,7 +76,8 @@ class TelemetryPublisher {
 // Wall clock in µs since the epoch: LCM's utime convention.
 std::int64_t wall_time_us() noexcept;
 
-// The loop's statistics as a telemetry item (the caller sets window_steps and paused).
+// The loop's statistics as a telemetry item. window_steps = steps in the histograms (since the
+// loop's last reset_histograms(), which the caller may do after each publish); the caller sets paused.
 PhysicsTiming timing_item(const runtime::LoopStats& s, std::uint64_t step, std::int64_t period_ns);
 
 }  // namespace vitreo::telemetry
