@@ -6,6 +6,7 @@
 
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/items.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "vitreo_lcm/command_ack_t.hpp"
 
@@ -76,15 +77,15 @@ Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const Comman
 }
 
 CommandServer::CommandServer(lcm::LCM& lcm, std::size_t queue_capacity) : lcm_(lcm), queue_(queue_capacity) {
-  sub_ = lcm_.subscribe(kChanCommand, &CommandServer::on_command, this);
+  sub_ = subscribe_to<vitreo_lcm::operator_command_t>(lcm_, kChanCommand, &dispatch_);
 }
 
 CommandServer::~CommandServer() {
   if (sub_) lcm_.unsubscribe(sub_);
 }
 
-void CommandServer::on_command(const lcm::ReceiveBuffer*, const std::string&,
-                               const vitreo_lcm::operator_command_t* cmd) {
+void CommandServer::on_command(const vitreo_lcm::operator_command_t& command) {
+  const vitreo_lcm::operator_command_t* cmd = &command;
   Verdict v;
   auto last = last_seq_.find(cmd->source);
   if (cmd->source.empty()) {

@@ -72,7 +72,11 @@ class CommandServer {
   std::uint64_t refused() const noexcept { return refused_; }
 
  private:
-  void on_command(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const vitreo_lcm::operator_command_t* cmd);
+  void on_command(const vitreo_lcm::operator_command_t& cmd);
+  struct Dispatch {
+    CommandServer* self;
+    void operator()(const vitreo_lcm::operator_command_t& cmd) { self->on_command(cmd); }
+  } dispatch_{this};
 
   lcm::LCM& lcm_;
   lcm::Subscription* sub_ = nullptr;

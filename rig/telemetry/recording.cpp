@@ -142,7 +142,7 @@ std::size_t Recorder::pump(std::int64_t now_ns) {
     write_input(in);
     ++n;
   }
-  if (now_ns - last_flush_ns_ >= config_.flush_interval_ns || last_flush_ns_ == INT64_MIN) {
+  if (last_flush_ns_ == INT64_MIN || now_ns - last_flush_ns_ >= config_.flush_interval_ns) {
     flush();
     last_flush_ns_ = now_ns;
   }

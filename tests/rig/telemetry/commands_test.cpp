@@ -11,6 +11,7 @@
 
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/commands.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 #include "vitreo_lcm/command_ack_t.hpp"
 #include "vitreo_lcm/operator_command_t.hpp"
 
@@ -78,9 +79,9 @@ TEST(CommandServer, AcksEveryCommandAndQueuesOnlyAcceptedOnesToPhysics) {
   CommandServer server(lc);
   struct Acks {
     std::vector<vitreo_lcm::command_ack_t> got;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const vitreo_lcm::command_ack_t* a) { got.push_back(*a); }
+    void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
   } acks;
-  lc.subscribe(kChanCommandAck, &Acks::on, &acks);
+  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
 
   // Physics publishes its context: case 1 of 2, running.
   CommandContext ctx;
@@ -143,9 +144,9 @@ TEST(CommandServer, FullPhysicsQueueRefusesWithAReason) {
   CommandServer server(lc, 2);
   struct Acks {
     std::vector<vitreo_lcm::command_ack_t> got;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const vitreo_lcm::command_ack_t* a) { got.push_back(*a); }
+    void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
   } acks;
-  lc.subscribe(kChanCommandAck, &Acks::on, &acks);
+  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
   for (int i = 1; i <= 3; ++i) {
     const Cmd c = make(Cmd::TOGGLE_LABELS, i);
     lc.publish(kChanCommand, &c);

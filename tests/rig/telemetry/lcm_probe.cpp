@@ -15,6 +15,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "vitreo_lcm/event_t.hpp"
 
@@ -70,12 +71,12 @@ int main(int argc, char** argv) {
       }
       struct Counter {
         long n = 0, in_order = 0;
-        void on(const lcm::ReceiveBuffer*, const std::string&, const vitreo_lcm::event_t* e) {
-          if (e->step == n) ++in_order;
+        void operator()(const vitreo_lcm::event_t& e) {
+          if (e.step == n) ++in_order;
           ++n;
         }
       } c;
-      lc.subscribe(kChanEvent, &Counter::on, &c);
+      subscribe_to<vitreo_lcm::event_t>(lc, kChanEvent, &c);
       std::printf("lcm_probe: subscribed\n");
       std::fflush(stdout);
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(std::atol(argv[4]));

@@ -25,6 +25,7 @@
 #include "rig/runtime/realtime.hpp"
 #include "rig/runtime/thread_harness.hpp"
 #include "rig/runtime/triple_buffer.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 
@@ -89,11 +90,11 @@ RunResult run_loop(Workload& work, std::uint64_t steps, bool loaded) {
   telemetry::TelemetrySource& src = pub.add_source("physics");
   struct Sub {
     std::uint64_t n = 0;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const vitreo_lcm::instrument_state_t* m) {
-      n += static_cast<std::uint64_t>(m->step >= 0);
+    void operator()(const vitreo_lcm::instrument_state_t& m) {
+      n += static_cast<std::uint64_t>(m.step >= 0);
     }
   } sub;
-  pub.lcm().subscribe(telemetry::kChanInstrumentState, &Sub::on, &sub);
+  telemetry::subscribe_to<vitreo_lcm::instrument_state_t>(pub.lcm(), telemetry::kChanInstrumentState, &sub);
 
   runtime::ThreadHarness* hp = nullptr;
   runtime::ThreadHarness h(clock, cfg, [&](std::uint64_t k, double t_s) {

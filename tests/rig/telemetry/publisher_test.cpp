@@ -16,6 +16,7 @@
 
 #include "rig/runtime/clock.hpp"
 #include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/event_t.hpp"
@@ -29,7 +30,7 @@ namespace {
 template <class Msg>
 struct Collector {
   std::vector<Msg> got;
-  void on(const lcm::ReceiveBuffer*, const std::string&, const Msg* m) { got.push_back(*m); }
+  void operator()(const Msg& m) { got.push_back(m); }
 };
 
 std::string temp_path(const std::string& stem) {
@@ -61,11 +62,11 @@ TEST(TelemetryPublisher, MemqRoundTripOfEveryItemType) {
   Collector<vitreo_lcm::physics_timing_t> timing;
   Collector<vitreo_lcm::device_status_t> status;
   Collector<vitreo_lcm::score_t> scores;
-  pub.lcm().subscribe(kChanInstrumentState, &decltype(states)::on, &states);
-  pub.lcm().subscribe(kChanEvent, &decltype(events)::on, &events);
-  pub.lcm().subscribe(kChanPhysicsTiming, &decltype(timing)::on, &timing);
-  pub.lcm().subscribe(kChanDeviceStatus, &decltype(status)::on, &status);
-  pub.lcm().subscribe(kChanScore, &decltype(scores)::on, &scores);
+  subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
+  subscribe_to<decltype(events.got)::value_type>(pub.lcm(), kChanEvent, &events);
+  subscribe_to<decltype(timing.got)::value_type>(pub.lcm(), kChanPhysicsTiming, &timing);
+  subscribe_to<decltype(status.got)::value_type>(pub.lcm(), kChanDeviceStatus, &status);
+  subscribe_to<decltype(scores.got)::value_type>(pub.lcm(), kChanScore, &scores);
 
   ASSERT_TRUE(physics.push(make_state(42)));
   Event e;
@@ -130,7 +131,7 @@ TEST(TelemetryPublisher, FullRingDropsAndCountsInsteadOfWaiting) {
   TelemetrySource& physics = pub.add_source("physics");
   TelemetrySource& driver = pub.add_source("tracker-driver", 4);
   Collector<vitreo_lcm::instrument_state_t> states;
-  pub.lcm().subscribe(kChanInstrumentState, &decltype(states)::on, &states);
+  subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
   // The telemetry thread is "stuck": nobody pumps. Producers keep going.
   std::uint64_t accepted = 0;
   for (int i = 0; i < 100; ++i) accepted += physics.push(make_state(i)) ? 1 : 0;
@@ -191,12 +192,12 @@ TEST(TelemetryPublisher, StalledSubscriberDoesNotSlowThePhysicsSide) {
       bool stall;
       std::atomic<bool>* done;
       std::atomic<bool>* in_handler;
-      void on(const lcm::ReceiveBuffer*, const std::string&, const vitreo_lcm::instrument_state_t*) {
+      void operator()(const vitreo_lcm::instrument_state_t&) {
         in_handler->store(true, std::memory_order_release);
         while (stall && !done->load(std::memory_order_acquire)) std::this_thread::yield();
       }
     } sub{stall, &physics_done, &in_handler};
-    pub.lcm().subscribe(kChanInstrumentState, &Sub::on, &sub);
+    subscribe_to<vitreo_lcm::instrument_state_t>(pub.lcm(), kChanInstrumentState, &sub);
     std::thread telemetry([&] {
       while (!physics_done.load(std::memory_order_acquire)) {
         pub.pump();
