@@ -171,6 +171,12 @@ TEST(TelemetryPublisher, FileProviderWritesALogThatLogFileReads) {
   std::remove(path.c_str());
 }
 
+TEST(TelemetryPublisher, DefaultUrlNeverLeavesThisMachine) {
+  // ttl=0: multicast datagrams are not forwarded off the host. Changing this is a deliberate act.
+  EXPECT_STREQ(kDefaultLcmUrl, "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_STREQ(PublisherConfig{}.url.c_str(), kDefaultLcmUrl);
+}
+
 TEST(TelemetryPublisher, BadUrlIsReportedNotIgnored) {
   EXPECT_THROW(TelemetryPublisher(PublisherConfig{"nosuchprovider://x", 16}), std::runtime_error);
 }

@@ -242,6 +242,25 @@ TEST(Replay, PacesInputsByTheirRecordedTimesOnASimulatedClock) {
   std::remove(path.c_str());
 }
 
+TEST(Replay, RealTimeOnTheWallClockTakesTheRecordedSpan) {
+  const std::string path = temp_path("rec-realtime");
+  const auto sent = record(path, 60);  // inputs ~1 ms apart: a ~59 ms span
+  const Recording rec = read_recording(path);
+  const double span_ns = static_cast<double>(sent.back().host_time_us - sent.front().host_time_us) * 1000.0;
+  SteadyClock wall;
+  std::vector<std::int64_t> late_ns;
+  const std::int64_t t0 = wall.now_ns();
+  replay(rec, wall, ReplayOptions{1.0}, [&](const DeviceInput& in) {
+    const double due = static_cast<double>(in.host_time_us - sent.front().host_time_us) * 1000.0;
+    late_ns.push_back(wall.now_ns() - t0 - static_cast<std::int64_t>(due));
+  });
+  const double elapsed = static_cast<double>(wall.now_ns() - t0);
+  EXPECT_GE(elapsed, span_ns) << "real-time replay ran ahead of the recording";
+  EXPECT_LT(elapsed, span_ns + 250e6);
+  for (std::int64_t l : late_ns) EXPECT_GE(l, 0) << "an input was delivered before its time";
+  std::remove(path.c_str());
+}
+
 TEST(Replay, InputCursorFeedsEachStepItsInputs) {
   Recording rec;
   for (std::int64_t step : {0, 0, 1, 3, 3, 3, 7}) {
