@@ -76,7 +76,9 @@ int main(int argc, char** argv) {
           ++n;
         }
       } c;
-      subscribe_to<vitreo_lcm::event_t>(lc, kChanEvent, &c);
+      // LCM keeps only 30 undelivered messages per subscription by default; under load this
+      // process may not run for longer than that takes to arrive, so keep them all.
+      subscribe_to<vitreo_lcm::event_t>(lc, kChanEvent, &c)->setQueueCapacity(static_cast<int>(n) + 16);
       std::printf("lcm_probe: subscribed\n");
       std::fflush(stdout);
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(std::atol(argv[4]));

@@ -41,8 +41,9 @@ for _ in $(seq 100); do  # wait for both to be listening (at most 5 s)
 done
 sleep 0.2
 "$probe" publish "" 1000
-wait $sub; sub=
+sub_rc=0; wait $sub || sub_rc=$?; sub=
 cat "$tmp/sub.out"
+[ $sub_rc -eq 0 ] || { echo "FAIL: subscriber exit $sub_rc"; exit 1; }
 sleep 0.3
 kill -INT $logger; wait $logger || true; logger=
 "$probe" count "$tmp/udpm.lcmlog" 1000
