@@ -49,6 +49,8 @@ class ThreadHarness {
 
   // After wait_physics()/stop(): the loop's statistics and the real-time outcome.
   const FixedStepLoop& loop() const noexcept { return loop_; }
+  // Mutable access for the physics thread itself (e.g. TimingReporter resetting histogram windows).
+  FixedStepLoop& loop() noexcept { return loop_; }
   const RealtimeOutcome& physics_realtime_outcome() const noexcept { return rt_outcome_; }
 
  private:

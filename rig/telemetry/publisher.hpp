@@ -80,4 +80,25 @@ std::int64_t wall_time_us() noexcept;
 // loop's last reset_histograms(), which the caller may do after each publish); the caller sets paused.
 PhysicsTiming timing_item(const runtime::LoopStats& s, std::uint64_t step, std::int64_t period_ns);
 
+// Physics-side helper: call on_step() from inside the step callback; every `every_steps` steps it
+// pushes a PhysicsTiming for the steps since its last report and starts a new histogram window.
+// Cost: one quantile scan of the histograms per report (a few µs at 10 Hz), no allocation.
+class TimingReporter {
+ public:
+  TimingReporter(runtime::FixedStepLoop& loop, TelemetrySource& out, std::uint32_t every_steps = 100)
+      : loop_(loop), out_(out), every_(every_steps ? every_steps : 1) {}
+  void on_step(std::uint64_t step, bool paused) {
+    if ((step + 1) % every_ != 0) return;
+    PhysicsTiming t = timing_item(loop_.stats(), step, loop_.config().period_ns);
+    t.paused = paused;
+    out_.push(t);
+    loop_.reset_histograms();
+  }
+
+ private:
+  runtime::FixedStepLoop& loop_;
+  TelemetrySource& out_;
+  std::uint32_t every_;
+};
+
 }  // namespace vitreo::telemetry

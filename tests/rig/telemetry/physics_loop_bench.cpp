@@ -12,6 +12,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -112,6 +113,8 @@ RunResult run_loop(Workload& work, std::uint64_t steps, bool loaded) {
       st.tip_mm[2] = 11.0 - t_s;
       src.push(st);
     }
+    // 10 Hz physics_timing_t. Not TimingReporter: its window resets would leave this benchmark
+    // only the last window's histogram to report.
     if (k % 100 == 99) src.push(telemetry::timing_item(hp->loop().stats(), k, cfg.loop.period_ns));
   });
   hp = &h;

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <memory>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "rig/runtime/clock.hpp"
+#include "rig/runtime/fixed_step_loop.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
@@ -169,6 +171,44 @@ TEST(TelemetryPublisher, FileProviderWritesALogThatLogFileReads) {
   }
   EXPECT_EQ(n, 100);
   std::remove(path.c_str());
+}
+
+TEST(TimingReporter, PublishesWindowedLoopTimingEveryNSteps) {
+  TelemetryPublisher pub(PublisherConfig{"memq://", 64});
+  TelemetrySource& physics = pub.add_source("physics");
+  Collector<vitreo_lcm::physics_timing_t> timing;
+  subscribe_to<vitreo_lcm::physics_timing_t>(pub.lcm(), kChanPhysicsTiming, &timing);
+  vitreo::runtime::SimulatedClock clock;
+  vitreo::runtime::FixedStepLoop* loop_ptr = nullptr;
+  std::unique_ptr<TimingReporter> reporter;
+  vitreo::runtime::FixedStepLoop loop(clock, vitreo::runtime::LoopConfig{}, [&](std::uint64_t k, double) {
+    // Steps 0-9 take 200 µs, steps 10-19 take 1.5 ms (overruns), 20-29 take 100 µs.
+    clock.advance(k < 10 ? 200'000 : (k < 20 ? 1'500'000 : 100'000));
+    reporter->on_step(k, k >= 20);
+  });
+  loop_ptr = &loop;
+  reporter = std::make_unique<TimingReporter>(*loop_ptr, physics, 10);
+  loop.run(30);
+  pub.pump();
+  while (pub.handle_incoming() > 0) {
+  }
+  ASSERT_EQ(timing.got.size(), 3u);
+  // A report is made inside step 10n+9, before that step's own time is recorded: the first window
+  // holds steps 0-8, later ones the ten steps before the reporting one.
+  EXPECT_EQ(timing.got[0].step, 9);
+  EXPECT_EQ(timing.got[0].window_steps, 9);
+  EXPECT_FLOAT_EQ(timing.got[0].step_max_us, 200.0f);
+  EXPECT_EQ(timing.got[0].overruns, 0);
+  EXPECT_EQ(timing.got[1].window_steps, 10);
+  EXPECT_FLOAT_EQ(timing.got[1].step_p50_us, 1500.0f);
+  EXPECT_EQ(timing.got[1].overruns, 9);  // cumulative: steps 10-18 recorded so far
+  EXPECT_FALSE(timing.got[1].paused);
+  EXPECT_EQ(timing.got[2].step, 29);
+  EXPECT_FLOAT_EQ(timing.got[2].step_p50_us, 100.0f);
+  EXPECT_FLOAT_EQ(timing.got[2].step_max_us, 1500.0f);  // step 19 is in this window
+  EXPECT_GT(timing.got[2].late_steps, 0);
+  EXPECT_TRUE(timing.got[2].paused);
+  EXPECT_EQ(timing.got[2].period_us, 1000);
 }
 
 TEST(TelemetryPublisher, DefaultUrlNeverLeavesThisMachine) {
