@@ -1,6 +1,7 @@
 #include "rig/telemetry/commands.hpp"
 
 #include <cmath>
+#include <cstdlib>
 
 #include <spdlog/spdlog.h>
 
@@ -38,6 +39,77 @@ bool valid_snapshot_name(const std::string& s) {
   return true;
 }
 }  // namespace
+
+ParsedCommand parse_command_line(const std::string& line, const std::string& source, std::int64_t seq) {
+  ParsedCommand out;
+  // Split into a word and an optional argument; a line that is exactly " " means the space key.
+  std::string word, arg;
+  if (line == " ") {
+    word = "space";
+  } else {
+    const auto b = line.find_first_not_of(" \t");
+    if (b == std::string::npos) {
+      out.error = "empty command";
+      return out;
+    }
+    const auto e = line.find_first_of(" \t", b);
+    word = line.substr(b, e == std::string::npos ? std::string::npos : e - b);
+    if (e != std::string::npos) {
+      const auto ab = line.find_first_not_of(" \t", e);
+      const auto ae = line.find_last_not_of(" \t\r\n");
+      if (ab != std::string::npos && ae >= ab) arg = line.substr(ab, ae - ab + 1);
+    }
+  }
+  auto& c = out.command;
+  c.utime_us = wall_time_us();
+  c.source = source;
+  c.seq = seq;
+  c.value = 0;
+  auto simple = [&](CommandCode code) {
+    if (!arg.empty()) {
+      out.error = "'" + word + "' takes no argument";
+      return;
+    }
+    c.command = static_cast<std::int8_t>(code);
+    out.ok = true;
+  };
+  if (word == "n" || word == "next") {
+    simple(CommandCode::NextCase);
+  } else if (word == "p" || word == "prev" || word == "previous") {
+    simple(CommandCode::PreviousCase);
+  } else if (word == "space" || word == "pause") {
+    simple(CommandCode::Pause);
+  } else if (word == "resume") {
+    simple(CommandCode::Resume);
+  } else if (word == "r" || word == "reset") {
+    simple(CommandCode::Reset);
+  } else if (word == "w" || word == "wireframe") {
+    simple(CommandCode::ToggleWireframe);
+  } else if (word == "l" || word == "labels") {
+    simple(CommandCode::ToggleLabels);
+  } else if (word == "s" || word == "save") {
+    if (arg.empty()) {
+      out.error = "save needs a snapshot name";
+    } else {
+      c.command = static_cast<std::int8_t>(CommandCode::SaveSnapshot);
+      c.arg = arg;
+      out.ok = true;
+    }
+  } else if (word == "z" || word == "zoom") {
+    char* end = nullptr;
+    const double v = arg.empty() ? 0.0 : std::strtod(arg.c_str(), &end);
+    if (arg.empty() || end == arg.c_str() || *end != '\0') {
+      out.error = "zoom needs a number, e.g. 'zoom 12.5'";
+    } else {
+      c.command = static_cast<std::int8_t>(CommandCode::Zoom);
+      c.value = v;
+      out.ok = true;
+    }
+  } else {
+    out.error = "unknown command '" + word + "' (n, p, pause, resume, r, s NAME, w, l, z X)";
+  }
+  return out;
+}
 
 Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const CommandContext& ctx) {
   auto refuse = [](std::string why) { return Verdict{false, std::move(why)}; };

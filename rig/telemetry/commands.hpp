@@ -48,6 +48,19 @@ struct Verdict {
 // Pure validation (no state beyond the arguments).
 Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const CommandContext& ctx);
 
+// The terminal's spelling of the commands (thesis ch. 2.6.1 keys, plus words), one per line:
+//   n | next            p | prev | previous        space | pause     resume
+//   r | reset           s NAME | save NAME          w | wireframe    l | labels
+//   z X | zoom X
+// Returns the command (utime_us/source/seq filled from the arguments) or an error message. Only
+// the syntax is checked here; the rig validates the rest and answers with an ack.
+struct ParsedCommand {
+  bool ok = false;
+  vitreo_lcm::operator_command_t command{};
+  std::string error;
+};
+ParsedCommand parse_command_line(const std::string& line, const std::string& source, std::int64_t seq);
+
 // An accepted command, as physics receives it.
 struct AcceptedCommand {
   CommandCode code = CommandCode::Pause;

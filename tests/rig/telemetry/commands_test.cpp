@@ -159,3 +159,31 @@ TEST(CommandServer, FullPhysicsQueueRefusesWithAReason) {
   EXPECT_FALSE(acks.got[2].accepted);
   EXPECT_EQ(acks.got[2].reason, "physics command queue is full");
 }
+
+TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
+  struct Case {
+    const char* line;
+    std::int8_t code;
+    double value;
+    const char* arg;
+  };
+  for (const Case& k : {Case{"n", Cmd::NEXT_CASE, 0, ""}, Case{"previous", Cmd::PREVIOUS_CASE, 0, ""},
+                        Case{" ", Cmd::PAUSE, 0, ""}, Case{"pause", Cmd::PAUSE, 0, ""},
+                        Case{"resume", Cmd::RESUME, 0, ""}, Case{"  r  ", Cmd::RESET, 0, ""},
+                        Case{"w", Cmd::TOGGLE_WIREFRAME, 0, ""}, Case{"labels", Cmd::TOGGLE_LABELS, 0, ""},
+                        Case{"s before-peel", Cmd::SAVE_SNAPSHOT, 0, "before-peel"},
+                        Case{"zoom 12.5", Cmd::ZOOM, 12.5, ""}, Case{"z 8\n", Cmd::ZOOM, 8, ""}}) {
+    const ParsedCommand p = parse_command_line(k.line, "terminal", 7);
+    ASSERT_TRUE(p.ok) << "'" << k.line << "': " << p.error;
+    EXPECT_EQ(p.command.command, k.code) << k.line;
+    EXPECT_DOUBLE_EQ(p.command.value, k.value) << k.line;
+    EXPECT_EQ(p.command.arg, k.arg) << k.line;
+    EXPECT_EQ(p.command.source, "terminal");
+    EXPECT_EQ(p.command.seq, 7);
+  }
+  for (const char* bad : {"", "   ", "zoom", "zoom x", "zoom 3x", "save", "n 3", "fly"}) {
+    const ParsedCommand p = parse_command_line(bad, "terminal", 1);
+    EXPECT_FALSE(p.ok) << "'" << bad << "' parsed";
+    EXPECT_FALSE(p.error.empty());
+  }
+}

@@ -3,6 +3,8 @@
 //   publish <url> <n>           publish n event_t through TelemetryPublisher, ~1 kHz
 //   subscribe <url> <n> <s>     count event_t until n arrived or s seconds passed; exit 0 iff n
 //   count <log> <n>             count decodable event_t in an LCM log; exit 0 iff exactly n
+//   respond <url> <n> <s>       stand-in rig: a CommandServer (case 1 of 3, running, zoom 1..25)
+//                               answering until n commands were handled or s seconds passed
 // A udpm URL ("" = the default) is refused unless VITREO_IN_PRIVATE_NETNS=1: this program must
 // never send multicast on the host network.
 #include <chrono>
@@ -15,6 +17,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/commands.hpp"
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "vitreo_lcm/event_t.hpp"
@@ -85,6 +88,25 @@ int main(int argc, char** argv) {
       while (c.n < n && std::chrono::steady_clock::now() < deadline) lc.handleTimeout(50);
       std::printf("lcm_probe: received %ld/%ld (%ld in order)\n", c.n, n, c.in_order);
       return c.n == n && c.in_order == n ? 0 : 1;
+    }
+    if (mode == "respond" && argc == 5) {
+      const std::string url = resolve(argv[2]);
+      if (!allowed(url)) return 3;
+      TelemetryPublisher pub(PublisherConfig{url, 16});
+      CommandServer server(pub.lcm());
+      CommandContext ctx;
+      ctx.case_index = 0;
+      ctx.case_count = 3;
+      server.context().write(ctx);
+      std::printf("lcm_probe: responding\n");
+      std::fflush(stdout);
+      const std::uint64_t n = static_cast<std::uint64_t>(std::atol(argv[3]));
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(std::atol(argv[4]));
+      while (server.accepted() + server.refused() < n && std::chrono::steady_clock::now() < deadline)
+        pub.lcm().handleTimeout(50);
+      std::printf("lcm_probe: %llu accepted, %llu refused\n", static_cast<unsigned long long>(server.accepted()),
+                  static_cast<unsigned long long>(server.refused()));
+      return 0;
     }
     if (mode == "count" && argc == 4) {
       lcm::LogFile log(argv[2], "r");

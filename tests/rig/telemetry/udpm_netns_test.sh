@@ -4,7 +4,8 @@
 # the real lcm-logger in another process, all in the namespace. Exits 77 (CTest skip) when this
 # machine does not allow `unshare -n`.
 set -u
-probe=${1:?usage: udpm_netns_test.sh <lcm_probe>}
+probe=${1:?usage: udpm_netns_test.sh <lcm_probe> <vitreo-cmd>}
+cmd=${2:?usage: udpm_netns_test.sh <lcm_probe> <vitreo-cmd>}
 if [ -z "${VITREO_IN_PRIVATE_NETNS:-}" ]; then
   if ! unshare -n true 2>/dev/null; then
     echo "SKIP: 'unshare -n' is not permitted here (needs root or unprivileged user namespaces); udpm not tested"
@@ -47,4 +48,19 @@ cat "$tmp/sub.out"
 sleep 0.3
 kill -INT $logger; wait $logger || true; logger=
 "$probe" count "$tmp/udpm.lcmlog" 1000
+
+echo "--- operator commands across processes: vitreo-cmd -> stand-in rig (CommandServer) -> ack"
+"$probe" respond "" 4 20 >"$tmp/resp.out" 2>&1 &
+sub=$!
+for _ in $(seq 100); do grep -q responding "$tmp/resp.out" && break; sleep 0.05; done
+"$cmd" --source ci --timeout-ms 5000 zoom 12.5 | tee "$tmp/c1"
+grep -q "zoom: accepted" "$tmp/c1"
+rc=0; "$cmd" --source ci --timeout-ms 5000 zoom 99 >"$tmp/c2" || rc=$?
+cat "$tmp/c2"; [ $rc -eq 1 ] && grep -q "refused: zoom 99" "$tmp/c2"
+rc=0; printf 'p\ns peel-start\n' | "$cmd" --source ci --timeout-ms 5000 >"$tmp/c3" || rc=$?
+cat "$tmp/c3"; [ $rc -eq 1 ] && grep -q "previous_case: refused: already at the first case" "$tmp/c3" \
+  && grep -q "save_snapshot: accepted" "$tmp/c3"
+wait $sub; sub=
+cat "$tmp/resp.out"
+grep -q "2 accepted, 2 refused" "$tmp/resp.out"
 echo "udpm in a private namespace: OK"
