@@ -135,8 +135,7 @@ Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const Comman
     case CommandCode::Zoom:
       if (!std::isfinite(cmd.value)) return refuse("zoom value is not a finite number");
       if (cmd.value < ctx.zoom_min || cmd.value > ctx.zoom_max)
-        return refuse("zoom " + std::to_string(cmd.value) + " outside " + std::to_string(ctx.zoom_min) + ".." +
-                      std::to_string(ctx.zoom_max));
+        return refuse(fmt::format("zoom {:g} outside the rig's range {:g}..{:g}", cmd.value, ctx.zoom_min, ctx.zoom_max));
       break;
     case CommandCode::Reset:
     case CommandCode::ToggleWireframe:
