@@ -15,7 +15,13 @@ namespace vitreo::runtime {
 ThreadHarness::ThreadHarness(Clock& physics_clock, HarnessConfig config, FixedStepLoop::StepFn physics_step)
     : config_(config), loop_(physics_clock, config.loop, std::move(physics_step)) {}
 
-ThreadHarness::~ThreadHarness() { stop(); }
+ThreadHarness::~ThreadHarness() {
+  try {
+    stop();
+  } catch (...) {
+    spdlog::error("harness: physics error not collected before destruction");
+  }
+}
 
 void ThreadHarness::add_service(std::string name, std::chrono::nanoseconds period, std::function<void()> fn) {
   if (started_) throw std::logic_error("ThreadHarness: add services before start()");
@@ -32,7 +38,13 @@ void ThreadHarness::start() {
   physics_ = std::thread([this] {
     pthread_setname_np(pthread_self(), "vitreo-physics");
     if (config_.physics_realtime) rt_outcome_ = apply_realtime(config_.physics_rt);
-    loop_.run(config_.max_steps);
+    try {
+      loop_.run(config_.max_steps);
+    } catch (...) {
+      // Not std::terminate: the caller decides (the rig logs, saves what it can, exits non-zero).
+      physics_error_ = std::current_exception();
+      spdlog::error("harness: the physics step threw; physics stopped at step {}", loop_.next_step_index());
+    }
     physics_done_.store(true, std::memory_order_release);
   });
   for (auto& sp : services_) {
@@ -46,18 +58,28 @@ void ThreadHarness::start() {
           spdlog::warn("harness: cannot set nice {} on service '{}'", config_.service_nice, s->name);
       }
       auto next = std::chrono::steady_clock::now();
+      auto call = [this, s] {
+        try {
+          s->fn();
+        } catch (const std::exception& e) {
+          service_errors_.fetch_add(1, std::memory_order_relaxed);
+          spdlog::error("harness: service '{}' threw: {}", s->name, e.what());
+        } catch (...) {
+          service_errors_.fetch_add(1, std::memory_order_relaxed);
+          spdlog::error("harness: service '{}' threw a non-standard exception", s->name);
+        }
+        ++s->calls;
+      };
       std::unique_lock lock(mu_);
       while (!services_stop_) {
         lock.unlock();
-        s->fn();
-        ++s->calls;
+        call();
         lock.lock();
         next += s->period;
         cv_.wait_until(lock, next, [this] { return services_stop_; });
       }
       lock.unlock();
-      s->fn();  // final drain after physics has stopped
-      ++s->calls;
+      call();  // final drain after physics has stopped
     });
   }
 }
@@ -66,7 +88,10 @@ void ThreadHarness::join_physics() {
   if (physics_.joinable()) physics_.join();
 }
 
-void ThreadHarness::wait_physics() { join_physics(); }
+void ThreadHarness::wait_physics() {
+  join_physics();
+  if (physics_error_) std::rethrow_exception(std::exchange(physics_error_, nullptr));
+}
 
 bool ThreadHarness::physics_done() const noexcept { return physics_done_.load(std::memory_order_acquire); }
 
@@ -83,6 +108,7 @@ void ThreadHarness::stop() {
   for (auto& s : services_) {
     if (s->thread.joinable()) s->thread.join();
   }
+  if (physics_error_) std::rethrow_exception(std::exchange(physics_error_, nullptr));
 }
 
 }  // namespace vitreo::runtime

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -42,9 +43,13 @@ class ThreadHarness {
 
   void start();
   // Stops physics, joins it, then stops and joins services (each gets one final call). Idempotent.
+  // Rethrows an exception that ended the physics thread (once).
   void stop();
-  // Blocks until the physics thread has finished (max_steps reached or stop()).
+  // Blocks until the physics thread has finished (max_steps reached, stop(), or an exception from
+  // the step function, which is rethrown here).
   void wait_physics();
+  // Exceptions thrown by service functions are logged and counted; the service keeps running.
+  std::uint64_t service_errors() const noexcept { return service_errors_.load(std::memory_order_relaxed); }
   bool physics_done() const noexcept;
 
   // After wait_physics()/stop(): the loop's statistics and the real-time outcome.
@@ -68,6 +73,8 @@ class ThreadHarness {
   RealtimeOutcome rt_outcome_;
   std::thread physics_;
   std::atomic<bool> physics_done_{false};
+  std::exception_ptr physics_error_;
+  std::atomic<std::uint64_t> service_errors_{0};
   std::vector<std::unique_ptr<Service>> services_;
   std::mutex mu_;  // services' sleep/stop signalling only: never touched by physics
   std::condition_variable cv_;

@@ -109,13 +109,7 @@ Recorder::Recorder(const std::string& path, RecordingHeader header, RecorderConf
   buf_.reserve(1024);
 }
 
-Recorder::~Recorder() {
-  try {
-    close();
-  } catch (const std::exception& e) {
-    spdlog::error("recorder: closing '{}': {}", path_, e.what());
-  }
-}
+Recorder::~Recorder() { close(); }
 
 void Recorder::write_input(const DeviceInput& in) {
   encode(to_lcm(in), buf_);
@@ -134,28 +128,53 @@ void Recorder::flush() {
   ++flushes_;
 }
 
-std::size_t Recorder::pump(std::int64_t now_ns) {
-  if (!log_) return 0;
-  std::size_t n = 0;
+void Recorder::fail(const char* what) noexcept {
+  if (!failed_) spdlog::error("{} — recording stopped, the session goes on", what);
+  failed_ = true;
+  log_.reset();  // closes the file: what was written so far stays readable
+}
+
+void Recorder::discard_queued() noexcept {
   DeviceInput in;
-  while (ring_.try_pop(in)) {
-    write_input(in);
-    ++n;
+  while (ring_.try_pop(in)) ++lost_;
+}
+
+std::size_t Recorder::pump(std::int64_t now_ns) noexcept {
+  if (!log_) {
+    discard_queued();
+    return 0;
   }
-  if (last_flush_ns_ == INT64_MIN || now_ns - last_flush_ns_ >= config_.flush_interval_ns) {
-    flush();
-    last_flush_ns_ = now_ns;
+  std::size_t n = 0;
+  try {
+    DeviceInput in;
+    while (ring_.try_pop(in)) {
+      write_input(in);
+      ++n;
+    }
+    if (last_flush_ns_ == INT64_MIN || now_ns - last_flush_ns_ >= config_.flush_interval_ns) {
+      flush();
+      last_flush_ns_ = now_ns;
+    }
+  } catch (const std::exception& e) {
+    ++lost_;  // the input being written
+    fail(e.what());
+    discard_queued();
   }
   return n;
 }
 
-void Recorder::close() {
+void Recorder::close() noexcept {
   if (!log_) return;
-  DeviceInput in;
-  while (ring_.try_pop(in)) write_input(in);
-  flush();
-  fdatasync(fileno(log_->getFilePtr()));
-  log_.reset();
+  try {
+    DeviceInput in;
+    while (ring_.try_pop(in)) write_input(in);
+    flush();
+    fdatasync(fileno(log_->getFilePtr()));
+    log_.reset();
+  } catch (const std::exception& e) {
+    fail(e.what());
+    discard_queued();
+  }
 }
 
 Recording read_recording(const std::string& path) {

@@ -74,10 +74,14 @@ class Recorder {
   bool push(const DeviceInput& in) noexcept { return ring_.try_push(in); }
 
   // Recorder thread: writes queued inputs; flushes when flush_interval has passed since the last
-  // flush (now_ns on any monotonic clock). Returns inputs written.
-  std::size_t pump(std::int64_t now_ns);
+  // flush (now_ns on any monotonic clock). Returns inputs written. Never throws: a write error (disk
+  // full, device gone) is logged once, the log is closed with what it has, and later inputs are
+  // drained and counted in lost() — a recording failure must not stop the session.
+  std::size_t pump(std::int64_t now_ns) noexcept;
   // Recorder thread: drain, flush and fdatasync, close. Idempotent; the destructor calls it.
-  void close();
+  void close() noexcept;
+  bool failed() const noexcept { return failed_; }
+  std::uint64_t lost() const noexcept { return lost_; }
 
   std::uint64_t written() const noexcept { return written_; }
   std::uint64_t dropped() const noexcept { return ring_.dropped(); }
@@ -87,6 +91,8 @@ class Recorder {
  private:
   void write_input(const DeviceInput& in);
   void flush();
+  void fail(const char* what) noexcept;
+  void discard_queued() noexcept;
 
   std::string path_;
   RecorderConfig config_;
@@ -98,6 +104,8 @@ class Recorder {
   std::int64_t last_flush_ns_ = INT64_MIN;
   std::uint64_t written_ = 0;
   std::uint64_t flushes_ = 0;
+  std::uint64_t lost_ = 0;
+  bool failed_ = false;
 };
 
 struct Recording {

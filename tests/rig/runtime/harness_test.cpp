@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <stdexcept>
 #include <thread>
 
 #include "rig/runtime/clock.hpp"
@@ -89,4 +90,26 @@ TEST(ThreadHarness, StalledConsumersDoNotStopPhysics) {
   h.stop();
   EXPECT_EQ(h.loop().stats().steps, 5000u);
   EXPECT_EQ(ring.dropped(), 5000u - 64u) << "the ring filled and the rest was dropped, not waited for";
+}
+
+TEST(ThreadHarness, PhysicsExceptionIsRethrownToTheCallerAndServiceExceptionsAreContained) {
+  SimulatedClock clock;
+  HarnessConfig cfg;
+  cfg.max_steps = 1000;
+  ThreadHarness h(clock, cfg, [&](std::uint64_t k, double) {
+    clock.advance(1000);
+    if (k == 5) throw std::runtime_error("solver diverged");
+  });
+  std::atomic<int> calls{0};
+  h.add_service("flaky", std::chrono::milliseconds(1), [&] {
+    ++calls;
+    throw std::runtime_error("sink unavailable");
+  });
+  h.start();
+  EXPECT_THROW(h.wait_physics(), std::runtime_error);
+  EXPECT_TRUE(h.physics_done());
+  EXPECT_EQ(h.loop().next_step_index(), 5u) << "physics stopped at the failing step";
+  EXPECT_NO_THROW(h.stop());  // already collected
+  EXPECT_GE(calls.load(), 1);
+  EXPECT_EQ(h.service_errors(), static_cast<std::uint64_t>(calls.load()));
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -134,6 +135,40 @@ TEST(Recording, FlushesAtTheConfiguredInterval) {
   rec.pump(100'000'000);  // 100 ms: flushed
   EXPECT_GT(file_size(path), after_first);
   rec.close();
+  std::remove(path.c_str());
+}
+
+// A write error mid-session (here: the file size limit, as a full disk would) stops the recording,
+// keeps what was written readable and never throws into the recorder thread.
+TEST(Recording, WriteFailureStopsRecordingWithoutStoppingTheSession) {
+  const std::string path = temp_path("rec-efbig");
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::signal(SIGXFSZ, SIG_IGN);  // get EFBIG instead of being killed
+    rlimit lim{16384, 16384};
+    ::setrlimit(RLIMIT_FSIZE, &lim);
+    RecorderConfig cfg;
+    cfg.flush_interval_ns = 0;  // flush on every pump
+    Recorder rec(path, make_header(), cfg);
+    std::uint64_t pushed = 0;
+    for (int i = 0; i < 400; ++i) {
+      pushed += rec.push(make_input(i)) ? 1 : 0;
+      if (i % 10 == 9) rec.pump(i);
+    }
+    rec.close();
+    if (!rec.failed()) ::_exit(10);
+    if (rec.written() + rec.lost() < pushed - 10) ::_exit(11);  // inputs in stdio's buffer at the failure are lost
+    const Recording back = read_recording(path);
+    if (back.inputs.empty() || back.inputs.size() > rec.written()) ::_exit(12);
+    for (std::size_t i = 0; i < back.inputs.size(); ++i)
+      if (!(back.inputs[i] == make_input(static_cast<std::int64_t>(i)))) ::_exit(13);
+    ::_exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "child failed at check " << WEXITSTATUS(status);
   std::remove(path.c_str());
 }
 
