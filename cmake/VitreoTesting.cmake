@@ -25,9 +25,17 @@ function(vitreo_add_test name)
   add_executable(${name} ${T_SOURCES})
   target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gmock GTest::gtest_main vitreo_options)
   target_compile_definitions(${name} PRIVATE VITREO_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  # Labels are set by a CTest include file that runs after discovery: passed through
+  # gtest_discover_tests(PROPERTIES LABELS a;b ...) a list is split into bogus property/value pairs
+  # (CMake 3.25), so a test with two labels silently lost the second one and its TIMEOUT.
   gtest_discover_tests(${name}
-    PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    TEST_LIST ${name}_TESTS
+    PROPERTIES TIMEOUT ${T_TIMEOUT}
     DISCOVERY_TIMEOUT 120)
+  set(_labels_file ${CMAKE_CURRENT_BINARY_DIR}/${name}_labels.cmake)
+  file(WRITE ${_labels_file}
+    "if(${name}_TESTS)\n  set_tests_properties(\${${name}_TESTS} PROPERTIES LABELS \"${T_LABELS}\")\nendif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${_labels_file})
 endfunction()
 
 function(vitreo_add_benchmark name)

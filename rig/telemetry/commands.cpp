@@ -1,0 +1,197 @@
+#include "rig/telemetry/commands.hpp"
+
+#include <cmath>
+#include <cstdlib>
+
+#include <spdlog/spdlog.h>
+
+#include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/items.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
+#include "rig/telemetry/publisher.hpp"
+#include "vitreo_lcm/command_ack_t.hpp"
+
+namespace vitreo::telemetry {
+
+const char* command_name(std::int8_t code) noexcept {
+  switch (static_cast<CommandCode>(code)) {
+    case CommandCode::NextCase: return "next_case";
+    case CommandCode::PreviousCase: return "previous_case";
+    case CommandCode::Pause: return "pause";
+    case CommandCode::Resume: return "resume";
+    case CommandCode::Reset: return "reset";
+    case CommandCode::SaveSnapshot: return "save_snapshot";
+    case CommandCode::ToggleWireframe: return "toggle_wireframe";
+    case CommandCode::ToggleLabels: return "toggle_labels";
+    case CommandCode::Zoom: return "zoom";
+  }
+  return "unknown";
+}
+
+namespace {
+bool valid_snapshot_name(const std::string& s) {
+  if (s.empty() || s.size() > 64 || s.front() == '.') return false;
+  for (char c : s) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                    c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+}  // namespace
+
+ParsedCommand parse_command_line(const std::string& line, const std::string& source, std::int64_t seq) {
+  ParsedCommand out;
+  // Split into a word and an optional argument; a line that is exactly " " means the space key.
+  std::string word, arg;
+  if (line == " ") {
+    word = "space";
+  } else {
+    const auto b = line.find_first_not_of(" \t");
+    if (b == std::string::npos) {
+      out.error = "empty command";
+      return out;
+    }
+    const auto e = line.find_first_of(" \t", b);
+    word = line.substr(b, e == std::string::npos ? std::string::npos : e - b);
+    if (e != std::string::npos) {
+      const auto ab = line.find_first_not_of(" \t", e);
+      const auto ae = line.find_last_not_of(" \t\r\n");
+      if (ab != std::string::npos && ae >= ab) arg = line.substr(ab, ae - ab + 1);
+    }
+  }
+  auto& c = out.command;
+  c.utime_us = wall_time_us();
+  c.source = source;
+  c.seq = seq;
+  c.value = 0;
+  auto simple = [&](CommandCode code) {
+    if (!arg.empty()) {
+      out.error = "'" + word + "' takes no argument";
+      return;
+    }
+    c.command = static_cast<std::int8_t>(code);
+    out.ok = true;
+  };
+  if (word == "n" || word == "next") {
+    simple(CommandCode::NextCase);
+  } else if (word == "p" || word == "prev" || word == "previous") {
+    simple(CommandCode::PreviousCase);
+  } else if (word == "space" || word == "pause") {
+    simple(CommandCode::Pause);
+  } else if (word == "resume") {
+    simple(CommandCode::Resume);
+  } else if (word == "r" || word == "reset") {
+    simple(CommandCode::Reset);
+  } else if (word == "w" || word == "wireframe") {
+    simple(CommandCode::ToggleWireframe);
+  } else if (word == "l" || word == "labels") {
+    simple(CommandCode::ToggleLabels);
+  } else if (word == "s" || word == "save") {
+    if (arg.empty()) {
+      out.error = "save needs a snapshot name";
+    } else {
+      c.command = static_cast<std::int8_t>(CommandCode::SaveSnapshot);
+      c.arg = arg;
+      out.ok = true;
+    }
+  } else if (word == "z" || word == "zoom") {
+    char* end = nullptr;
+    const double v = arg.empty() ? 0.0 : std::strtod(arg.c_str(), &end);
+    if (arg.empty() || end == arg.c_str() || *end != '\0') {
+      out.error = "zoom needs a number, e.g. 'zoom 12.5'";
+    } else {
+      c.command = static_cast<std::int8_t>(CommandCode::Zoom);
+      c.value = v;
+      out.ok = true;
+    }
+  } else {
+    out.error = "unknown command '" + word + "' (n, p, pause, resume, r, s NAME, w, l, z X)";
+  }
+  return out;
+}
+
+Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const CommandContext& ctx) {
+  auto refuse = [](std::string why) { return Verdict{false, std::move(why)}; };
+  switch (static_cast<CommandCode>(cmd.command)) {
+    case CommandCode::NextCase:
+      if (ctx.case_index + 1 >= ctx.case_count)
+        return refuse("already at the last case (" + std::to_string(ctx.case_index + 1) + " of " +
+                      std::to_string(ctx.case_count) + ")");
+      break;
+    case CommandCode::PreviousCase:
+      if (ctx.case_index <= 0) return refuse("already at the first case");
+      break;
+    case CommandCode::Pause:
+      if (ctx.paused) return refuse("physics is already paused");
+      break;
+    case CommandCode::Resume:
+      if (!ctx.paused) return refuse("physics is not paused");
+      break;
+    case CommandCode::SaveSnapshot:
+      if (!valid_snapshot_name(cmd.arg))
+        return refuse("snapshot name must be 1-64 characters of [A-Za-z0-9._-], not starting with '.'");
+      break;
+    case CommandCode::Zoom:
+      if (!std::isfinite(cmd.value)) return refuse("zoom value is not a finite number");
+      if (cmd.value < ctx.zoom_min || cmd.value > ctx.zoom_max)
+        return refuse(fmt::format("zoom {:g} outside the rig's range {:g}..{:g}", cmd.value, ctx.zoom_min, ctx.zoom_max));
+      break;
+    case CommandCode::Reset:
+    case CommandCode::ToggleWireframe:
+    case CommandCode::ToggleLabels:
+      break;
+    default:
+      return refuse("unknown command code " + std::to_string(cmd.command));
+  }
+  return Verdict{true, {}};
+}
+
+CommandServer::CommandServer(lcm::LCM& lcm, std::size_t queue_capacity) : lcm_(lcm), queue_(queue_capacity) {
+  sub_ = subscribe_to<vitreo_lcm::operator_command_t>(lcm_, kChanCommand, &dispatch_);
+}
+
+CommandServer::~CommandServer() {
+  if (sub_) lcm_.unsubscribe(sub_);
+}
+
+void CommandServer::on_command(const vitreo_lcm::operator_command_t& command) {
+  const vitreo_lcm::operator_command_t* cmd = &command;
+  Verdict v;
+  auto last = last_seq_.find(cmd->source);
+  if (cmd->source.empty()) {
+    v = {false, "command has no source"};
+  } else if (last != last_seq_.end() && cmd->seq <= last->second) {
+    v = {false, "sequence " + std::to_string(cmd->seq) + " is not after " + std::to_string(last->second) +
+                    " from '" + cmd->source + "' (duplicate or reordered)"};
+  } else {
+    v = validate_command(*cmd, context_.read());
+  }
+  if (!cmd->source.empty() && (last == last_seq_.end() || cmd->seq > last->second)) last_seq_[cmd->source] = cmd->seq;
+
+  if (v.accepted) {
+    AcceptedCommand a;
+    a.code = static_cast<CommandCode>(cmd->command);
+    a.value = cmd->value;
+    copy_text(a.arg, cmd->arg);
+    a.seq = cmd->seq;
+    if (!queue_.try_push(a)) v = {false, "physics command queue is full"};
+  }
+  vitreo_lcm::command_ack_t ack;
+  ack.utime_us = wall_time_us();
+  ack.source = cmd->source;
+  ack.seq = cmd->seq;
+  ack.command = cmd->command;
+  ack.accepted = v.accepted;
+  ack.reason = v.reason;
+  lcm_.publish(kChanCommandAck, &ack);
+  if (v.accepted) {
+    ++accepted_;
+    spdlog::info("command {} #{} from '{}' accepted", command_name(cmd->command), cmd->seq, cmd->source);
+  } else {
+    ++refused_;
+    spdlog::warn("command {} #{} from '{}' refused: {}", command_name(cmd->command), cmd->seq, cmd->source, v.reason);
+  }
+}
+
+}  // namespace vitreo::telemetry

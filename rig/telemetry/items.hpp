@@ -1,0 +1,91 @@
+#pragma once
+// What producers (physics, driver threads) push towards the telemetry thread: fixed-size, trivially
+// copyable records, so a push is a memcpy into a preallocated ring slot — no allocation, no
+// encoding, no system call on the producer's thread. The telemetry thread turns them into LCM
+// messages (strings, variable arrays) and publishes.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+#include <type_traits>
+#include <variant>
+
+namespace vitreo::telemetry {
+
+template <std::size_t N>
+void copy_text(char (&dst)[N], std::string_view src) noexcept {
+  const std::size_t n = std::min(N - 1, src.size());
+  std::copy_n(src.data(), n, dst);
+  dst[n] = '\0';
+}
+
+// The text of a fixed field, stopping at its first NUL or its end (never reads past it).
+template <std::size_t N>
+std::string_view text(const char (&src)[N]) noexcept {
+  std::size_t n = 0;
+  while (n < N && src[n] != '\0') ++n;
+  return {src, n};
+}
+
+struct InstrumentState {
+  std::int64_t step = 0;
+  double t_s = 0;
+  std::int8_t instrument_id = 0;
+  std::int8_t port_id = -1;
+  char kind[16] = {};
+  double tip_mm[3] = {};
+  double shaft_axis[3] = {};
+  double roll_rad = 0;
+  double insertion_mm = 0;
+  double actuation = 0;
+  bool frozen = false;
+};
+
+enum class EventKind : std::int8_t { Contact = 1, Cut = 2, Tear = 3, Burn = 4, Drain = 5, AttachmentBroken = 6 };
+
+struct Event {
+  std::int64_t step = 0;
+  double t_s = 0;
+  EventKind kind = EventKind::Contact;
+  std::int8_t instrument_id = -1;
+  std::int32_t tissue_id = -1;
+  double position_mm[3] = {};
+  double magnitude = 0;  // unit per kind: see event_t.lcm
+};
+
+struct PhysicsTiming {
+  std::int64_t step = 0;
+  std::int32_t period_us = 1000;
+  std::int32_t window_steps = 0;
+  float step_p50_us = 0, step_p99_us = 0, step_max_us = 0;
+  float jitter_p99_us = 0, jitter_max_us = 0;
+  std::int64_t overruns = 0, late_steps = 0, dropped_steps = 0;
+  bool paused = false;
+};
+
+struct DeviceStatus {
+  std::int32_t device_id = 0;
+  char name[24] = {};
+  char transport[40] = {};
+  std::int8_t state = 0;  // device_status_t::STATE_*
+  char detail[64] = {};
+  std::int64_t frames_rx = 0, frames_tx = 0, bytes_rx = 0, crc_errors = 0, framing_errors = 0;
+  std::int64_t sequence_gaps = 0, heartbeat_misses = 0, reconnects = 0, last_sample_age_us = 0;
+  float sample_rate_hz = 0, latency_p50_us = 0, latency_p99_us = 0, clock_offset_us = 0;
+};
+
+struct Score {
+  static constexpr std::size_t kMaxMetrics = 12;
+  std::int64_t step = 0;
+  char case_id[32] = {};
+  bool final_score = false;
+  double total = 0;
+  std::uint8_t n = 0;
+  char name[kMaxMetrics][24] = {};
+  double value[kMaxMetrics] = {};
+};
+
+using TelemetryItem = std::variant<InstrumentState, Event, PhysicsTiming, DeviceStatus, Score>;
+static_assert(std::is_trivially_copyable_v<TelemetryItem>, "ring items must be memcpy-able");
+
+}  // namespace vitreo::telemetry

@@ -1,0 +1,175 @@
+#include "rig/telemetry/publisher.hpp"
+
+#include <ctime>
+#include <stdexcept>
+#include <type_traits>
+
+#include "vitreo_lcm/device_status_t.hpp"
+#include "vitreo_lcm/event_t.hpp"
+#include "vitreo_lcm/instrument_state_t.hpp"
+#include "vitreo_lcm/physics_timing_t.hpp"
+#include "vitreo_lcm/score_t.hpp"
+
+namespace vitreo::telemetry {
+
+std::int64_t wall_time_us() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000 + ts.tv_nsec / 1000;
+}
+
+PhysicsTiming timing_item(const runtime::LoopStats& s, std::uint64_t step, std::int64_t period_ns) {
+  PhysicsTiming t;
+  t.step = static_cast<std::int64_t>(step);
+  t.period_us = static_cast<std::int32_t>(period_ns / 1000);
+  t.step_p50_us = static_cast<float>(s.step_p50_ns) * 1e-3f;
+  t.step_p99_us = static_cast<float>(s.step_p99_ns) * 1e-3f;
+  t.step_max_us = static_cast<float>(s.step_max_ns) * 1e-3f;
+  t.jitter_p99_us = static_cast<float>(s.jitter_p99_ns) * 1e-3f;
+  t.jitter_max_us = static_cast<float>(s.jitter_max_ns) * 1e-3f;
+  t.overruns = static_cast<std::int64_t>(s.overruns);
+  t.late_steps = static_cast<std::int64_t>(s.late_steps);
+  t.dropped_steps = static_cast<std::int64_t>(s.dropped_steps);
+  t.window_steps = static_cast<std::int32_t>(s.window_steps);
+  return t;
+}
+
+TelemetryPublisher::TelemetryPublisher(PublisherConfig config) : config_(std::move(config)), lcm_(config_.url) {
+  if (!lcm_.good()) throw std::runtime_error("telemetry: cannot open LCM URL '" + config_.url + "'");
+}
+
+TelemetrySource& TelemetryPublisher::add_source(std::string name, std::size_t capacity) {
+  return sources_.emplace_back(std::move(name), capacity ? capacity : config_.default_capacity);
+}
+
+std::uint64_t TelemetryPublisher::dropped() const noexcept {
+  std::uint64_t n = 0;
+  for (const auto& s : sources_) n += s.dropped();
+  return n;
+}
+
+int TelemetryPublisher::handle_incoming(int max_messages) {
+  int n = 0;
+  while (n < max_messages && lcm_.handleTimeout(0) > 0) ++n;
+  return n;
+}
+
+std::size_t TelemetryPublisher::pump() {
+  std::size_t n = 0;
+  TelemetryItem item;
+  for (auto& s : sources_) {
+    // Bounded per call so one busy source cannot starve the others or the command channel.
+    std::size_t budget = s.ring_.capacity();
+    while (budget-- > 0 && s.ring_.try_pop(item)) {
+      publish_item(item);
+      ++n;
+    }
+  }
+  return n;
+}
+
+namespace {
+template <class Msg>
+int publish(lcm::LCM& lc, const char* chan, const Msg& m) {
+  return lc.publish(chan, &m);
+}
+}  // namespace
+
+void TelemetryPublisher::publish_item(const TelemetryItem& item) {
+  const std::int64_t now = wall_time_us();
+  int rc = 0;
+  std::visit(
+      [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, InstrumentState>) {
+          vitreo_lcm::instrument_state_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.t_s = v.t_s;
+          m.instrument_id = v.instrument_id;
+          m.port_id = v.port_id;
+          m.kind = text(v.kind);
+          for (int i = 0; i < 3; ++i) {
+            m.tip_mm[i] = v.tip_mm[i];
+            m.shaft_axis[i] = v.shaft_axis[i];
+          }
+          m.roll_rad = v.roll_rad;
+          m.insertion_mm = v.insertion_mm;
+          m.actuation = v.actuation;
+          m.frozen = v.frozen;
+          rc = publish(lcm_, kChanInstrumentState, m);
+        } else if constexpr (std::is_same_v<T, Event>) {
+          vitreo_lcm::event_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.t_s = v.t_s;
+          m.kind = static_cast<std::int8_t>(v.kind);
+          m.instrument_id = v.instrument_id;
+          m.tissue_id = v.tissue_id;
+          for (int i = 0; i < 3; ++i) m.position_mm[i] = v.position_mm[i];
+          m.magnitude = v.magnitude;
+          rc = publish(lcm_, kChanEvent, m);
+        } else if constexpr (std::is_same_v<T, PhysicsTiming>) {
+          vitreo_lcm::physics_timing_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.period_us = v.period_us;
+          m.window_steps = v.window_steps;
+          m.step_p50_us = v.step_p50_us;
+          m.step_p99_us = v.step_p99_us;
+          m.step_max_us = v.step_max_us;
+          m.jitter_p99_us = v.jitter_p99_us;
+          m.jitter_max_us = v.jitter_max_us;
+          m.overruns = v.overruns;
+          m.late_steps = v.late_steps;
+          m.dropped_steps = v.dropped_steps;
+          m.telemetry_dropped = static_cast<std::int64_t>(dropped());
+          m.paused = v.paused;
+          rc = publish(lcm_, kChanPhysicsTiming, m);
+        } else if constexpr (std::is_same_v<T, DeviceStatus>) {
+          vitreo_lcm::device_status_t m;
+          m.utime_us = now;
+          m.device_id = v.device_id;
+          m.name = text(v.name);
+          m.transport = text(v.transport);
+          m.state = v.state;
+          m.detail = text(v.detail);
+          m.frames_rx = v.frames_rx;
+          m.frames_tx = v.frames_tx;
+          m.bytes_rx = v.bytes_rx;
+          m.crc_errors = v.crc_errors;
+          m.framing_errors = v.framing_errors;
+          m.sequence_gaps = v.sequence_gaps;
+          m.heartbeat_misses = v.heartbeat_misses;
+          m.reconnects = v.reconnects;
+          m.last_sample_age_us = v.last_sample_age_us;
+          m.sample_rate_hz = v.sample_rate_hz;
+          m.latency_p50_us = v.latency_p50_us;
+          m.latency_p99_us = v.latency_p99_us;
+          m.clock_offset_us = v.clock_offset_us;
+          rc = publish(lcm_, kChanDeviceStatus, m);
+        } else if constexpr (std::is_same_v<T, Score>) {
+          vitreo_lcm::score_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.case_id = text(v.case_id);
+          m.final_score = v.final_score;
+          m.total = v.total;
+          const std::size_t n = std::min<std::size_t>(v.n, Score::kMaxMetrics);
+          m.n = static_cast<std::int16_t>(n);
+          for (std::size_t i = 0; i < n; ++i) {
+            m.name.emplace_back(text(v.name[i]));
+            m.value.push_back(v.value[i]);
+          }
+          rc = publish(lcm_, kChanScore, m);
+        }
+      },
+      item);
+  if (rc == 0) {
+    ++published_;
+  } else {
+    ++publish_errors_;
+  }
+}
+
+}  // namespace vitreo::telemetry

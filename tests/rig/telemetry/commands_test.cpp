@@ -1,0 +1,189 @@
+// Operator commands: validation rules, and the CommandServer over a real memq LCM (commands in,
+// acknowledgements out, accepted commands queued to physics).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/commands.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
+#include "vitreo_lcm/command_ack_t.hpp"
+#include "vitreo_lcm/operator_command_t.hpp"
+
+using namespace vitreo::telemetry;
+using Cmd = vitreo_lcm::operator_command_t;
+
+namespace {
+Cmd make(std::int8_t code, std::int64_t seq = 1, double value = 0, std::string arg = {}, std::string source = "test") {
+  Cmd c;
+  c.utime_us = 0;
+  c.source = std::move(source);
+  c.seq = seq;
+  c.command = code;
+  c.value = value;
+  c.arg = std::move(arg);
+  return c;
+}
+}  // namespace
+
+TEST(CommandValidation, AcceptsValidCommandsAndRefusesBadOnesWithAReason) {
+  CommandContext ctx;
+  ctx.case_index = 0;
+  ctx.case_count = 3;
+  ctx.paused = false;
+  EXPECT_TRUE(validate_command(make(Cmd::NEXT_CASE), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::PREVIOUS_CASE), ctx).accepted);
+  EXPECT_EQ(validate_command(make(Cmd::PREVIOUS_CASE), ctx).reason, "already at the first case");
+  ctx.case_index = 2;
+  EXPECT_FALSE(validate_command(make(Cmd::NEXT_CASE), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::PREVIOUS_CASE), ctx).accepted);
+
+  EXPECT_TRUE(validate_command(make(Cmd::PAUSE), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::RESUME), ctx).accepted);
+  ctx.paused = true;
+  EXPECT_FALSE(validate_command(make(Cmd::PAUSE), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::RESUME), ctx).accepted);
+
+  EXPECT_TRUE(validate_command(make(Cmd::RESET), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_WIREFRAME), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_LABELS), ctx).accepted);
+
+  EXPECT_TRUE(validate_command(make(Cmd::ZOOM, 1, 10.0), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::ZOOM, 1, 25.0), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::ZOOM, 1, 0.5), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::ZOOM, 1, 26.0), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::ZOOM, 1, std::nan("")), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::ZOOM, 1, std::numeric_limits<double>::infinity()), ctx).accepted);
+
+  EXPECT_TRUE(validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, "before-peel_2.v1"), ctx).accepted);
+  for (const char* bad : {"", "../etc/passwd", "a/b", ".hidden", "spa ce", "x\n"}) {
+    const Verdict v = validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, bad), ctx);
+    EXPECT_FALSE(v.accepted) << "'" << bad << "'";
+    EXPECT_FALSE(v.reason.empty());
+  }
+  EXPECT_FALSE(validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, std::string(65, 'a')), ctx).accepted);
+
+  const Verdict unknown = validate_command(make(42), ctx);
+  EXPECT_FALSE(unknown.accepted);
+  EXPECT_EQ(unknown.reason, "unknown command code 42");
+}
+
+TEST(CommandServer, AcksEveryCommandAndQueuesOnlyAcceptedOnesToPhysics) {
+  lcm::LCM lc("memq://");
+  ASSERT_TRUE(lc.good());
+  CommandServer server(lc);
+  struct Acks {
+    std::vector<vitreo_lcm::command_ack_t> got;
+    void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
+  } acks;
+  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
+
+  // Physics publishes its context: case 1 of 2, running.
+  CommandContext ctx;
+  ctx.case_index = 0;
+  ctx.case_count = 2;
+  server.context().write(ctx);
+
+  const std::vector<Cmd> sent = {
+      make(Cmd::ZOOM, 1, 12.5),
+      make(Cmd::PREVIOUS_CASE, 2),                 // refused: first case
+      make(Cmd::ZOOM, 2, 8.0),                     // refused: seq 2 again from "test"
+      make(Cmd::SAVE_SNAPSHOT, 3, 0, "peel-start"),
+      make(Cmd::PAUSE, 1, 0, {}, "instructor-ui"),  // another source has its own sequence
+      make(Cmd::RESUME, 4),                        // refused: not paused (context not yet updated)
+      make(Cmd::PAUSE, 5, 0, {}, ""),              // refused: no source
+  };
+  for (const auto& c : sent) lc.publish(kChanCommand, &c);
+  while (lc.handleTimeout(0) > 0) {
+  }
+
+  ASSERT_EQ(acks.got.size(), 7u);
+  const std::vector<bool> want = {true, false, false, true, true, false, false};
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(static_cast<bool>(acks.got[i].accepted), want[i]) << i << ": " << acks.got[i].reason;
+    EXPECT_EQ(acks.got[i].seq, sent[i].seq);
+    EXPECT_EQ(acks.got[i].command, sent[i].command);
+    EXPECT_EQ(acks.got[i].source, sent[i].source);
+    EXPECT_EQ(acks.got[i].reason.empty(), want[i]);
+  }
+  EXPECT_NE(acks.got[2].reason.find("duplicate or reordered"), std::string::npos) << acks.got[2].reason;
+  EXPECT_EQ(server.accepted(), 3u);
+  EXPECT_EQ(server.refused(), 4u);
+
+  AcceptedCommand a;
+  ASSERT_TRUE(server.poll(a));
+  EXPECT_EQ(a.code, CommandCode::Zoom);
+  EXPECT_DOUBLE_EQ(a.value, 12.5);
+  ASSERT_TRUE(server.poll(a));
+  EXPECT_EQ(a.code, CommandCode::SaveSnapshot);
+  EXPECT_STREQ(a.arg, "peel-start");
+  ASSERT_TRUE(server.poll(a));
+  EXPECT_EQ(a.code, CommandCode::Pause);
+  EXPECT_FALSE(server.poll(a));
+
+  // Physics applies the pause and republishes its context: now RESUME is accepted.
+  ctx.paused = true;
+  server.context().write(ctx);
+  const Cmd resume = make(Cmd::RESUME, 6);
+  lc.publish(kChanCommand, &resume);
+  while (lc.handleTimeout(0) > 0) {
+  }
+  ASSERT_EQ(acks.got.size(), 8u);
+  EXPECT_TRUE(acks.got.back().accepted) << acks.got.back().reason;
+  ASSERT_TRUE(server.poll(a));
+  EXPECT_EQ(a.code, CommandCode::Resume);
+}
+
+TEST(CommandServer, FullPhysicsQueueRefusesWithAReason) {
+  lcm::LCM lc("memq://");
+  CommandServer server(lc, 2);
+  struct Acks {
+    std::vector<vitreo_lcm::command_ack_t> got;
+    void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
+  } acks;
+  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
+  for (int i = 1; i <= 3; ++i) {
+    const Cmd c = make(Cmd::TOGGLE_LABELS, i);
+    lc.publish(kChanCommand, &c);
+  }
+  while (lc.handleTimeout(0) > 0) {
+  }
+  ASSERT_EQ(acks.got.size(), 3u);
+  EXPECT_TRUE(acks.got[0].accepted);
+  EXPECT_TRUE(acks.got[1].accepted);
+  EXPECT_FALSE(acks.got[2].accepted);
+  EXPECT_EQ(acks.got[2].reason, "physics command queue is full");
+}
+
+TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
+  struct Case {
+    const char* line;
+    std::int8_t code;
+    double value;
+    const char* arg;
+  };
+  for (const Case& k : {Case{"n", Cmd::NEXT_CASE, 0, ""}, Case{"previous", Cmd::PREVIOUS_CASE, 0, ""},
+                        Case{" ", Cmd::PAUSE, 0, ""}, Case{"pause", Cmd::PAUSE, 0, ""},
+                        Case{"resume", Cmd::RESUME, 0, ""}, Case{"  r  ", Cmd::RESET, 0, ""},
+                        Case{"w", Cmd::TOGGLE_WIREFRAME, 0, ""}, Case{"labels", Cmd::TOGGLE_LABELS, 0, ""},
+                        Case{"s before-peel", Cmd::SAVE_SNAPSHOT, 0, "before-peel"},
+                        Case{"zoom 12.5", Cmd::ZOOM, 12.5, ""}, Case{"z 8\n", Cmd::ZOOM, 8, ""}}) {
+    const ParsedCommand p = parse_command_line(k.line, "terminal", 7);
+    ASSERT_TRUE(p.ok) << "'" << k.line << "': " << p.error;
+    EXPECT_EQ(p.command.command, k.code) << k.line;
+    EXPECT_DOUBLE_EQ(p.command.value, k.value) << k.line;
+    EXPECT_EQ(p.command.arg, k.arg) << k.line;
+    EXPECT_EQ(p.command.source, "terminal");
+    EXPECT_EQ(p.command.seq, 7);
+  }
+  for (const char* bad : {"", "   ", "zoom", "zoom x", "zoom 3x", "save", "n 3", "fly"}) {
+    const ParsedCommand p = parse_command_line(bad, "terminal", 1);
+    EXPECT_FALSE(p.ok) << "'" << bad << "' parsed";
+    EXPECT_FALSE(p.error.empty());
+  }
+}
