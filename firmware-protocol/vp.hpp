@@ -30,6 +30,9 @@ struct CanFrame {
   bool fd = false;
   Bytes data;
 };
+// Framing of an already-encoded packet (simulators corrupt packets before framing them).
+Bytes frame_serial(std::span<const std::uint8_t> packet);
+Bytes frame_usb(std::span<const std::uint8_t> packet);
 std::optional<CanFrame> encode_canfd(const vp_message& m, std::uint8_t node_id);
 std::vector<CanFrame> encode_can_classic(const vp_message& m, std::uint8_t node_id,
                                          std::uint8_t transfer_id);

@@ -211,6 +211,21 @@ Bytes encode_usb(const vp_message& m) {
   b.resize(n);
   return b;
 }
+Bytes frame_usb(std::span<const std::uint8_t> packet) {
+  Bytes b(packet.begin(), packet.end());
+  std::uint16_t crc = vp_crc16(packet.data(), packet.size());
+  b.push_back(std::uint8_t(crc >> 8));
+  b.push_back(std::uint8_t(crc));
+  return b;
+}
+Bytes frame_serial(std::span<const std::uint8_t> packet) {
+  Bytes raw = frame_usb(packet);
+  Bytes out(raw.size() + raw.size() / 254 + 2);
+  std::size_t n = vp_cobs_encode(raw.data(), raw.size(), out.data(), out.size());
+  out.resize(n);
+  out.push_back(0);
+  return out;
+}
 std::optional<CanFrame> encode_canfd(const vp_message& m, std::uint8_t node_id) {
   CanFrame f;
   f.fd = true;
