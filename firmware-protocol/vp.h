@@ -225,7 +225,9 @@ vp_status vp_usb_encode(const vp_message* m, uint8_t* out, size_t cap, size_t* o
 vp_status vp_usb_decode(const uint8_t* in, size_t len, vp_message* out);
 
 /* ---- CAN ---------------------------------------------------------------------------------------- */
-/* 29-bit extended ID: [28:26] priority, [25:18] message type, [17:7] reserved 0, [6:0] node id. */
+/* 29-bit extended ID: [28:26] priority, [25:18] message type, [17] direction (1 = host to device),
+ * [16:7] reserved 0, [6:0] node id (the sender's; for host-to-device frames the addressee's). */
+#define VP_CAN_ID_TO_DEVICE (1uL << 17)
 uint32_t vp_can_id(uint8_t priority, uint8_t type, uint8_t node_id);
 uint8_t vp_can_default_priority(uint8_t type);
 vp_status vp_can_parse_id(uint32_t can_id, uint8_t* priority, uint8_t* type, uint8_t* node_id);

@@ -195,7 +195,7 @@ uint8_t vp_can_default_priority(uint8_t type) {
 
 vp_status vp_can_parse_id(uint32_t can_id, uint8_t* priority, uint8_t* type, uint8_t* node_id) {
   if (can_id > 0x1FFFFFFFu) return VP_ERR_FRAMING;
-  if (can_id & 0x3FF80u) return VP_ERR_FRAMING; /* reserved bits [17:7] must be zero */
+  if (can_id & 0x1FF80u) return VP_ERR_FRAMING; /* reserved bits [16:7] must be zero */
   if (priority) *priority = (uint8_t)((can_id >> 26) & 7u);
   if (type) *type = (uint8_t)((can_id >> 18) & 0xFFu);
   if (node_id) *node_id = (uint8_t)(can_id & 0x7Fu);
