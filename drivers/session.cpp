@@ -135,9 +135,12 @@ void DeviceSession::transport_up(std::uint64_t now_us) {
 }
 
 void DeviceSession::transport_down(std::uint64_t now_us, const char* why) {
-  if (state_ == LinkState::lost || state_ == LinkState::reconnecting) return;
-  ++stats_.disconnects;
   last_error_ = why;
+  if (state_ == LinkState::lost || state_ == LinkState::reconnecting) {
+    next_reconnect_us_ = now_us + cfg_.reconnect_interval_us;
+    return;
+  }
+  ++stats_.disconnects;
   next_reconnect_us_ = now_us + cfg_.reconnect_interval_us;
   set_state(LinkState::lost, now_us, why);
 }
