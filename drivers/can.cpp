@@ -142,6 +142,11 @@ void CanDevice::handle(const CanRxFrame& f, std::uint64_t now_us) {
   std::uint8_t node = 0;
   int st = f.fd ? vp_canfd_decode(f.id, f.data, f.len, &node, &m) : vp_can_rx_push(&rx_, f.id, f.data, f.len, &node, &m);
   if (st == VP_NEED_MORE) return;  // a segment of a classic transfer
+  if (st == VP_OK && node != node_) {
+    // the kernel filter should have stopped it; counted so a filter failure is visible
+    ++can_stats_.foreign_frames;
+    return;
+  }
   session_.on_frame(st, m, now_us);
 }
 

@@ -48,14 +48,22 @@ constexpr std::int64_t kDriftPpm = 200;  // crystal tolerance of both ends, gene
 void ClockMapper::on_sample(std::uint64_t device_us, std::uint64_t host_rx_us) {
   const std::int64_t observed = static_cast<std::int64_t>(host_rx_us) - static_cast<std::int64_t>(device_us);
   if (!have_) {
-    offset_us_ = observed;
+    offset_us_ = min_offset_us_ = observed;
+    min_host_us_ = host_rx_us;
     have_ = true;
   } else if (!synced_) {
-    // let the minimum creep towards newer observations at the drift allowance, so that a device
-    // clock running slow relative to the host does not leave the estimate behind for ever
-    const std::int64_t dt = static_cast<std::int64_t>(host_rx_us - last_host_us_);
-    const std::int64_t allowed = offset_us_ + dt * kDriftPpm / 1'000'000;
-    offset_us_ = observed < allowed ? observed : allowed;
+    // the minimum may creep up at the drift allowance since it was observed, so a device clock
+    // running slow relative to the host does not leave the estimate behind for ever (computed
+    // from the minimum's age: per-sample increments would round to zero at 1 kHz)
+    const std::int64_t age = static_cast<std::int64_t>(host_rx_us - min_host_us_);
+    const std::int64_t allowed = min_offset_us_ + age * kDriftPpm / 1'000'000;
+    if (observed <= allowed) {
+      min_offset_us_ = observed;
+      min_host_us_ = host_rx_us;
+      offset_us_ = observed;
+    } else {
+      offset_us_ = allowed;
+    }
   }
   last_host_us_ = host_rx_us;
 }

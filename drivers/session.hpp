@@ -118,6 +118,8 @@ class ClockMapper {
   bool have_ = false;
   bool synced_ = false;
   std::int64_t offset_us_ = 0;
+  std::int64_t min_offset_us_ = 0;
+  std::uint64_t min_host_us_ = 0;
   std::uint64_t last_host_us_ = 0;
   std::uint64_t best_rtt_us_ = 0;
 };
