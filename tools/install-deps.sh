@@ -20,6 +20,8 @@ packages=(
   qemu-system-x86 linux-image-amd64 busybox-static cpio
   # protocol fuzz targets: clang's libFuzzer (GCC has none)
   clang libclang-rt-14-dev
+  # the protocol is also compiled for Cortex-M in the tests (the firmware's target)
+  gcc-arm-none-eabi
 )
 
 missing=()
