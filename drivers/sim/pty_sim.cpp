@@ -79,6 +79,7 @@ void PtySimDevice::step(std::uint64_t now_us) {
     proto::Bytes f = proto::frame_serial(p);
     emu_.corrupt(f);
     ssize_t n = ::write(master_, f.data(), f.size());
+    if (n > 0) bytes_written_ += static_cast<std::uint64_t>(n);
     if (n != static_cast<ssize_t>(f.size())) ++tx_overflows_;  // UART FIFO overflow: frame lost
   }
 }

@@ -28,6 +28,7 @@ class PtySimDevice {
   const std::string& slave_path() const { return slave_name_; }
   FirmwareEmulator& emulator() { return emu_; }
   std::uint64_t tx_overflows() const { return tx_overflows_; }
+  std::uint64_t bytes_written() const { return bytes_written_; }
 
  private:
   void open_pty();
@@ -40,6 +41,7 @@ class PtySimDevice {
   int slave_keep_ = -1;  // keeps the slave's raw settings alive while no driver has it open
   bool manual_unplug_ = false;
   std::uint64_t tx_overflows_ = 0;
+  std::uint64_t bytes_written_ = 0;
   proto::SerialDecoder rx_;
 };
 

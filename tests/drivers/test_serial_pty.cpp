@@ -55,12 +55,23 @@ struct Bench {
            : m.type == VP_MSG_PEDAL_STATE ? m.u.pedal.timestamp_us
                                           : m.u.eyeball.timestamp_us;
   }
+  // Lock-step: after each simulated millisecond, wait (in poll, which returns as soon as bytes
+  // arrive) until the driver has read what the device wrote in it. Without this a loaded machine
+  // could hold bytes in the pty for a real millisecond while the manual clock runs ahead by 50.
   void run_ms(int ms) {
     for (int i = 0; i < ms; ++i) {
       clock.advance_us(1000);
+      const std::uint64_t w0 = device.bytes_written(), r0 = driver.session().stats().bytes;
       device.step(clock.now_us());
+      const std::uint64_t target = r0 + (device.bytes_written() - w0);
       driver.poll(0);
+      for (int k = 0; k < 50 && device.plugged() && driver.session().stats().bytes < target && port_open(); ++k)
+        driver.poll(1);
     }
+  }
+  bool port_open() const {
+    const auto s = driver.session().state();
+    return s != LinkState::lost && s != LinkState::reconnecting;
   }
   // Lets the pty deliver what is in flight (the only real-time wait: microseconds in practice).
   void drain() {
