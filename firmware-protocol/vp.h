@@ -21,9 +21,10 @@ extern "C" {
 #define VP_HEADER_SIZE 4u   /* version, type, sequence, payload length */
 #define VP_MAX_PAYLOAD 56u  /* so a packet plus CRC fits a 64-byte USB packet / CAN FD frame */
 #define VP_MAX_PACKET (VP_HEADER_SIZE + VP_MAX_PAYLOAD)
-#define VP_CRC_SIZE 2u
+#define VP_CRC_SIZE 2u         /* CRC-16: USB transfers and multi-frame CAN transfers */
+#define VP_SERIAL_CRC_SIZE 4u  /* CRC-32C: serial frames (no lower layer checks a UART) */
 /* serial frame: COBS(packet + CRC) adds at most one byte per 254, plus the 0x00 delimiter */
-#define VP_SERIAL_MAX_FRAME (VP_MAX_PACKET + VP_CRC_SIZE + 2u)
+#define VP_SERIAL_MAX_FRAME (VP_MAX_PACKET + VP_SERIAL_CRC_SIZE + 2u)
 #define VP_USB_MAX_PACKET (VP_MAX_PACKET + VP_CRC_SIZE)
 #define VP_CANFD_MAX_DATA 64u
 #define VP_CAN_MAX_SEGMENTS 10u /* ceil((60 + 2) / 7) */
@@ -196,18 +197,21 @@ const char* vp_msg_type_name(uint8_t type);
 uint16_t vp_crc16(const uint8_t* data, size_t len);
 uint16_t vp_crc16_update(uint16_t crc, const uint8_t* data, size_t len);
 
+/* ---- CRC-32C (Castagnoli; reflected poly 0x82F63B78, init/xorout 0xFFFFFFFF); check = 0xE3069283 */
+uint32_t vp_crc32c(const uint8_t* data, size_t len);
+
 /* ---- COBS (Cheshire & Baker 1999) --------------------------------------------------------------- */
 /* Returns encoded length (no delimiter), 0 if cap is too small. */
 size_t vp_cobs_encode(const uint8_t* in, size_t len, uint8_t* out, size_t cap);
 /* Decodes a frame without its delimiter. Returns decoded length or a negative vp_status. */
 int vp_cobs_decode(const uint8_t* in, size_t len, uint8_t* out, size_t cap);
 
-/* ---- serial: COBS(packet || CRC16 big-endian) || 0x00 ------------------------------------------- */
+/* ---- serial: COBS(packet || CRC32C big-endian) || 0x00 ------------------------------------------ */
 vp_status vp_serial_encode(const vp_message* m, uint8_t* out, size_t cap, size_t* out_len);
 
 typedef struct {
   uint8_t buf[VP_SERIAL_MAX_FRAME];
-  size_t len;
+  size_t len; /* bytes of the current frame so far */
   uint8_t discarding; /* after an overflow: drop bytes up to the next delimiter */
 } vp_serial_rx;
 

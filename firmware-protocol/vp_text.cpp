@@ -219,7 +219,9 @@ Bytes frame_usb(std::span<const std::uint8_t> packet) {
   return b;
 }
 Bytes frame_serial(std::span<const std::uint8_t> packet) {
-  Bytes raw = frame_usb(packet);
+  Bytes raw(packet.begin(), packet.end());
+  const std::uint32_t crc = vp_crc32c(packet.data(), packet.size());
+  for (int shift : {24, 16, 8, 0}) raw.push_back(std::uint8_t(crc >> shift));
   Bytes out(raw.size() + raw.size() / 254 + 2);
   std::size_t n = vp_cobs_encode(raw.data(), raw.size(), out.data(), out.size());
   out.resize(n);

@@ -32,6 +32,18 @@ def crc16(data):  # CRC-16/CCITT-FALSE, bit by bit
 assert crc16(b'123456789') == 0x29B1
 
 
+def crc32c(data):  # CRC-32C (Castagnoli), reflected, bit by bit
+    crc = 0xFFFFFFFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = (crc >> 1) ^ 0x82F63B78 if crc & 1 else crc >> 1
+    return crc ^ 0xFFFFFFFF
+
+
+assert crc32c(b'123456789') == 0xE3069283
+
+
 def cobs(data):
     out, block = bytearray(), bytearray()
     for b in data:
@@ -86,7 +98,7 @@ def packet(kind, seq, f, major=MAJOR, minor=MINOR, type_override=None, extra=b''
 
 
 def serial(pkt, corrupt_at=None):
-    body = pkt + struct.pack('>H', crc16(pkt))
+    body = pkt + struct.pack('>I', crc32c(pkt))
     if corrupt_at is not None:
         body = bytearray(body)
         body[corrupt_at] ^= 0x10

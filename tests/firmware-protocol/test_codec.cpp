@@ -56,6 +56,7 @@ vp_message sample(vp_msg_type t, std::uint8_t seq) {
 TEST(ProtocolCodec, Crc16CheckValue) {
   const char* s = "123456789";
   EXPECT_EQ(vp_crc16(reinterpret_cast<const std::uint8_t*>(s), 9), 0x29B1);
+  EXPECT_EQ(vp_crc32c(reinterpret_cast<const std::uint8_t*>(s), 9), 0xE3069283u);
 }
 
 TEST(ProtocolCodec, CobsKnownEncodings) {
