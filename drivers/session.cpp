@@ -215,6 +215,7 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       return;
     case VP_MSG_STATUS:
       if (m.u.status.severity >= 2) last_error_ = "device reports error code " + std::to_string(m.u.status.code);
+      if (on_message_) on_message_(m);
       return;
     case VP_MSG_POSE_SAMPLE: {
       const auto& p = m.u.pose;
@@ -264,8 +265,19 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       deliver(s, p.timestamp_us, now_us);
       return;
     }
-    default: return;  // heartbeat, calibration results: keep the link alive, nothing to deliver
+    default:  // heartbeat, calibration results: keep the link alive, handed to the message hook
+      if (on_message_) on_message_(m);
+      return;
   }
+}
+
+bool DeviceSession::request_calibration(std::uint8_t procedure, std::uint8_t instrument_id, std::uint16_t token) {
+  if (state_ == LinkState::lost || state_ == LinkState::reconnecting) return false;
+  vp_message m{};
+  m.type = VP_MSG_CALIB_REQUEST;
+  m.u.calib_request = {procedure, instrument_id, token};
+  send(m);
+  return true;
 }
 
 void DeviceSession::deliver(Sample s, std::uint64_t device_us, std::uint64_t now_us) {

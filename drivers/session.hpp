@@ -140,11 +140,18 @@ class DeviceSession {
   using SendFn = std::function<void(const vp_message&)>;
   using SampleFn = std::function<void(const Sample&)>;
   using StateFn = std::function<void(LinkState from, LinkState to, const char* why)>;
+  using MessageFn = std::function<void(const vp_message&)>;
 
   explicit DeviceSession(SessionConfig cfg = {}) : cfg_(cfg) {}
   void set_send(SendFn f) { send_ = std::move(f); }
   void set_on_sample(SampleFn f) { on_sample_ = std::move(f); }
   void set_on_state(StateFn f) { on_state_ = std::move(f); }
+  // Valid messages that are not samples (status, calibration results, heartbeats), for the rig's
+  // calibration and diagnostics code.
+  void set_on_message(MessageFn f) { on_message_ = std::move(f); }
+  // Asks the device to run a calibration procedure; the CALIB_RESULT echoes `token`.
+  // False when the link is not up (connecting/configuring/streaming/stale).
+  bool request_calibration(std::uint8_t procedure, std::uint8_t instrument_id, std::uint16_t token);
 
   // Transport events.
   void transport_up(std::uint64_t now_us);
@@ -177,6 +184,7 @@ class DeviceSession {
   SendFn send_;
   SampleFn on_sample_;
   StateFn on_state_;
+  MessageFn on_message_;
   LinkState state_ = LinkState::lost;
   LinkStats stats_;
   vp_device_info info_{};

@@ -285,6 +285,26 @@ TEST(SerialPty, ScriptedDisconnectReconnects) {
   EXPECT_EQ(b.driver.session().state(), LinkState::streaming);
 }
 
+TEST(SerialPty, CalibrationRequestGetsItsResult) {
+  Bench b(sim::default_script(sim::DeviceKind::tracker));
+  std::vector<vp_calib_result> results;
+  b.driver.session().set_on_message([&](const vp_message& m) {
+    if (m.type == VP_MSG_CALIB_RESULT) results.push_back(m.u.calib_result);
+  });
+  b.run_ms(100);
+  ASSERT_TRUE(b.driver.session().request_calibration(0, 1, 0xBEEF));
+  b.run_ms(10);
+  b.drain();
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].token, 0xBEEF);
+  EXPECT_EQ(results[0].instrument_id, 1);
+  EXPECT_EQ(results[0].result, 0);
+  b.device.unplug();
+  b.run_ms(2);
+  b.drain();
+  EXPECT_FALSE(b.driver.session().request_calibration(0, 1, 1)) << "refused while the link is down";
+}
+
 TEST(SimScript, ParseErrorsNameTheLine) {
   sim::Script s;
   std::string err;
