@@ -134,6 +134,7 @@ void DeviceSession::transport_up(std::uint64_t now_us) {
   configured_ = false;
   last_seq_ = -1;
   have_device_us_ = false;
+  last_host_us_ = 0;
   same_count_ = 0;
   clock_.reset();
   last_frame_us_ = now_us;
@@ -294,7 +295,12 @@ void DeviceSession::deliver(Sample s, std::uint64_t device_us, std::uint64_t now
   last_device_us_ = device_us;
   have_device_us_ = true;
   clock_.on_sample(device_us, now_us);
-  SampleTime t{device_us, clock_.to_host_us(device_us), now_us};
+  // consumers interpolate between samples: the mapped time must not step back when the offset
+  // estimate improves (a less-delayed sample lowers the minimum)
+  std::uint64_t host = clock_.to_host_us(device_us);
+  if (host < last_host_us_) host = last_host_us_;
+  last_host_us_ = host;
+  SampleTime t{device_us, host, now_us, info_.serial};
   const std::uint64_t lat = t.received_us > t.host_us ? t.received_us - t.host_us : 0;
   ++stats_.latency_count;
   stats_.latency_last_us = lat;

@@ -40,8 +40,9 @@ class ManualClock final : public Clock {
 // host time it was received (PX4's timestamp_sample vs timestamp).
 struct SampleTime {
   std::uint64_t device_us = 0;
-  std::uint64_t host_us = 0;      // device_us mapped into the host clock
+  std::uint64_t host_us = 0;      // device_us mapped into the host clock; never decreases on a link
   std::uint64_t received_us = 0;  // host clock at reception
+  std::uint32_t device_serial = 0;  // from DEVICE_INFO: which device took the sample
 };
 struct PoseSample {
   SampleTime t;
@@ -193,7 +194,7 @@ class DeviceSession {
   ClockMapper clock_;
   std::uint64_t last_frame_us_ = 0, last_sample_us_ = 0, state_since_us_ = 0;
   std::uint64_t next_retry_us_ = 0, next_sync_us_ = 0, next_reconnect_us_ = 0;
-  std::uint64_t last_device_us_ = 0;
+  std::uint64_t last_device_us_ = 0, last_host_us_ = 0;
   bool have_device_us_ = false;
   int last_seq_ = -1;
   std::uint8_t tx_seq_ = 0, sync_exchange_ = 0;

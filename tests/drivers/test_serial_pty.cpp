@@ -136,6 +136,13 @@ TEST(SerialPty, TrackerHandshakeThenStreams) {
     EXPECT_LE(std::llabs(static_cast<long long>(s->t.host_us) - truth), 2000);
   }
   EXPECT_LE(st.latency_max_us, 3000u);
+  std::uint64_t prev = 0;
+  for (auto& s : b.got) {
+    auto& p = std::get<PoseSample>(s);
+    EXPECT_GE(p.t.host_us, prev);
+    EXPECT_EQ(p.t.device_serial, 1001u);
+    prev = p.t.host_us;
+  }
   std::printf("tracker over pty: %s\n", to_string(st).c_str());
 }
 
