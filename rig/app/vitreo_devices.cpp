@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -262,6 +263,8 @@ int main(int argc, char** argv) {
   CLI::App app{"vitreo-devices: list, identify, watch and simulate the rig's devices "
                "(tracker, pedals, eyeball fixture) over serial, USB and CAN"};
   app.require_subcommand(1);
+  // log to stderr: stdout carries the data (identities, samples, dumps) so it can be piped
+  spdlog::set_default_logger(spdlog::stderr_color_mt("vitreo-devices"));
   spdlog::set_pattern("[%H:%M:%S.%e] %^%l%$ %v");
 
   app.add_subcommand("list", "list serial ports, vitreo USB devices and CAN interfaces");

@@ -5,6 +5,7 @@
 #include <linux/can.h>
 #include <net/if.h>
 #include <linux/can/error.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -310,6 +311,39 @@ void test_cansend_vectors_reach_our_decoder() {
   CHECK(checked == 20, "all 20 CAN vectors (10 FD, 10 classic)");
 }
 
+// The technicians' tool on a real (virtual) CAN bus: one instance simulates the eyeball fixture,
+// another identifies and watches it.
+void test_tool_over_can() {
+  if (access("/bin/vitreo-devices", X_OK) != 0) {
+    std::printf("== vitreo-devices not in the VM image: tool check skipped\n");
+    return;
+  }
+  std::printf("== vitreo-devices simulate / identify / watch over vcan0\n");
+  int sim = spawn({"vitreo-devices", "simulate", "--device", "eyeball", "--can", kIf, "--node", "33", "--duration-s", "8"},
+                  "/tmp/tool-sim.log");
+  CHECK(sim > 0, "spawn simulate");
+  usleep(500000);
+  int rc = wait_for(spawn({"vitreo-devices", "identify", "--can", kIf, "--node", "33", "--timeout-s", "3"}, "/tmp/tool-id.log"));
+  std::ifstream id("/tmp/tool-id.log");
+  std::string idline;
+  std::getline(id, idline);
+  std::printf("  identify: %s\n", idline.c_str());
+  CHECK(rc == 0 && idline.rfind("eyeball fixture serial 3001", 0) == 0, "identify rc=%d '%s'", rc, idline.c_str());
+  rc = wait_for(spawn({"vitreo-devices", "watch", "--can", kIf, "--node", "33", "--duration-s", "2", "--print-hz", "2"},
+                      "/tmp/tool-watch.log"));
+  std::ifstream w("/tmp/tool-watch.log");
+  std::string line;
+  int eye = 0, streaming = 0;
+  while (std::getline(w, line)) {
+    eye += line.rfind("eye ", 0) == 0;
+    streaming += line.rfind("[streaming]", 0) == 0;
+  }
+  std::printf("  watch: %d sample lines, %d streaming status lines\n", eye, streaming);
+  CHECK(rc == 0 && eye >= 2 && streaming >= 1, "watch rc=%d eye=%d streaming=%d", rc, eye, streaming);
+  kill(sim, SIGTERM);
+  CHECK(wait_for(sim) == 0, "simulate stops cleanly on SIGTERM");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -328,6 +362,7 @@ int main(int argc, char** argv) {
   test_error_frames_and_bus_off();
   test_candump_reads_our_frames();
   test_cansend_vectors_reach_our_decoder();
+  test_tool_over_can();
   std::printf("@@CAN %s: %d checks, %d failed@@\n", g_fail ? "FAIL" : "PASS", g_checks, g_fail);
   return g_fail ? 1 : 0;
 }
