@@ -4,7 +4,8 @@
 
 add_library(vitreo_options INTERFACE)
 target_compile_options(vitreo_options INTERFACE
-  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Woverloaded-virtual
+  -Wall -Wextra -Wpedantic -Wshadow
+  $<$<COMPILE_LANGUAGE:CXX>:-Wnon-virtual-dtor> $<$<COMPILE_LANGUAGE:CXX>:-Woverloaded-virtual>
   -Wimplicit-fallthrough -Wformat=2 -Wundef
   -ffp-contract=off -fno-fast-math)
 

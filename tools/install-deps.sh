@@ -18,6 +18,10 @@ packages=(
   umockdev libumockdev-dev can-utils iproute2 util-linux
   # SocketCAN tests run inside a small qemu VM (the host kernel has no CAN)
   qemu-system-x86 linux-image-amd64 busybox-static cpio
+  # protocol fuzz targets: clang's libFuzzer (GCC has none)
+  clang libclang-rt-14-dev
+  # the protocol is also compiled for Cortex-M in the tests (the firmware's target)
+  gcc-arm-none-eabi
 )
 
 missing=()
