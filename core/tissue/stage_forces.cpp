@@ -79,6 +79,23 @@ void TissueWorld::compute_external_accelerations(double h) {
       }
     }
 
+    // Vitrector suction (thesis ch. 2.6.2.2): only inside each port's hemisphere, scaled by the
+    // cosine of the angle off the port axis, capped like the thesis' clamp on small new vertices.
+    for (const SuctionField& f : suction_) {
+      const double r2 = f.radius_mm * f.radius_mm;
+      for_each_awake_vertex(s, [&](std::uint32_t v) {
+        if (!view.vertex_alive[v] || view.inverse_mass[v] == 0.0) return;
+        const Vec3 out = view.x[v] - f.apex_mm;
+        const double d2 = out.squaredNorm();
+        if (d2 > r2 || !(d2 > 1e-18)) return;
+        const double along = out.dot(f.axis);
+        if (along <= 0.0) return;  // behind the port: outside the hemisphere
+        const double d = std::sqrt(d2);
+        const double cosine = along / d;
+        sc.acceleration[v] -= out * (f.pressure_pa * cosine * view.vertex_area[v] / d);
+      });
+    }
+
     const bool walled = s.contained_by_globe();
     const double added_per_area = env.fluid_density_g_per_mm3 * s.material().entrained_fluid_mm;
     const double mu = settings_.wall_friction;

@@ -222,6 +222,9 @@ StepReport TissueWorld::step(double dt_s) {
     return report;
   }
   for (auto& at : attachments_) at.peak_force_un = 0.0;
+  for (std::uint32_t i = 0; i < grip_high_water_; ++i) grips_[i].peak_force_un = 0.0;
+  std::fill(contact_force_.begin(), contact_force_.end(), Vec3::Zero());
+  std::fill(contact_depth_.begin(), contact_depth_.end(), 0.0);
 
   prepare_sleep_groups();
   save_rollback();
@@ -242,10 +245,20 @@ StepReport TissueWorld::step(double dt_s) {
     for (int it = 0; it < settings_.iterations; ++it) {
       for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, h, accumulate);
       project_attachments(h, accumulate);
+      const double fraction = static_cast<double>(sub + 1) / substeps;
+      project_grips(h, fraction);
+      project_contacts(h, fraction);
       project_wall();
     }
     finite = update_velocities(h);
   }
+
+  // The instruments' poses of this step become the start of the next.
+  for (std::uint32_t c = 0; c < collider_count_; ++c) {
+    colliders_[c].a0 = colliders_[c].a1;
+    colliders_[c].b0 = colliders_[c].b1;
+  }
+  for (std::uint32_t i = 0; i < grip_high_water_; ++i) grips_[i].previous_target = grips_[i].d.target_mm;
 
   if (!finite) {
     restore_rollback();
@@ -258,6 +271,7 @@ StepReport TissueWorld::step(double dt_s) {
 
   for (auto& sp : surfaces_) sp->apply_plasticity(dt_s);
   break_attachments();
+  break_grips();
   tear_overstrained();
   finish_sleep();
   for (const auto& e : events_) {

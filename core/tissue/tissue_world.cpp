@@ -41,6 +41,12 @@ TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings
   settings_.validate();
   events_.reserve(256);
   tear_candidates_.reserve(4096);
+  colliders_.resize(kMaxColliders);
+  candidates_.reserve(kMaxContactCandidates);
+  suction_.reserve(kMaxSuctionFields);
+  contact_force_.assign(std::size_t{kMaxColliders} * kMaxContactSurfaces, Vec3::Zero());
+  contact_depth_.assign(kMaxColliders, 0.0);
+  grips_.resize(kMaxGrips);
 }
 
 std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -88,7 +89,47 @@ struct LocalForceDescription {
   double scale = 1.0;
 };
 
-enum class TissueEventKind : std::uint8_t { kTear, kAttachmentBroken, kRolledBack };
+// ---- Instruments acting on tissue (filled by core/instruments each step) -----------------------
+// A kinematic capsule the tissue cannot enter: an instrument's shaft or tip part, given at the start
+// (a0, b0) and the end (a1, b1) of the step; the substeps interpolate between them, so a fast tool
+// sweeps instead of jumping.
+struct ColliderCapsule {
+  Vec3 a0 = Vec3::Zero(), b0 = Vec3::Zero(), a1 = Vec3::Zero(), b1 = Vec3::Zero();
+  double radius_mm = 0.0;
+};
+
+// A triangle that may touch a collider during the step (from the broad phase in core/collision).
+// `side` (+1/−1) is the side of the triangle's plane (along its normal) the collider was on before
+// the step: the tissue is pushed to stay on its side, so a triangle can never be crossed.
+struct ContactCandidate {
+  std::uint32_t collider = 0;
+  std::uint32_t surface = 0;
+  std::uint32_t triangle = 0;
+  std::int8_t side = 1;
+};
+
+// A surface point given by barycentric coordinates on a triangle, held to a target point by a stiff
+// zero-length spring: a forceps grasp (target = the jaw frame) or a laser adhesion (target fixed).
+struct GripDescription {
+  std::uint32_t surface = 0;
+  TriangleId triangle;
+  Vec3 bary{1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
+  Vec3 target_mm = Vec3::Zero();
+  double stiffness_un_per_mm = 1e5;
+  double break_force_un = std::numeric_limits<double>::infinity();
+};
+
+// Suction of a vitrector port: tissue inside the hemisphere of `radius_mm` in front of `apex_mm`
+// (along `axis`) is drawn toward the apex with `pressure_pa` × (cosine of the angle off the axis) on
+// its area (thesis ch. 2.6.2.2); nothing outside the hemisphere feels it.
+struct SuctionField {
+  Vec3 apex_mm = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();
+  double radius_mm = 0.0;
+  double pressure_pa = 0.0;
+};
+
+enum class TissueEventKind : std::uint8_t { kTear, kAttachmentBroken, kRolledBack, kGripBroken };
 
 struct TissueEvent {
   TissueEventKind kind;
@@ -125,6 +166,37 @@ class TissueWorld {
   Status set_environment(const Environment& environment);
   Status set_local_force_scale(std::uint32_t force, double scale);
   double local_force_scale(std::uint32_t force) const { return local_forces_.at(force).d.scale; }
+  std::uint32_t local_force_count() const { return static_cast<std::uint32_t>(local_forces_.size()); }
+  const LocalForceDescription& local_force(std::uint32_t force) const { return local_forces_.at(force).d; }
+  // Sum of the current detachment pressures (Pa, scaled, weighted) acting on a vertex.
+  double local_pressure_on(std::uint32_t surface, std::uint32_t vertex) const;
+
+  // ---- Instruments (never throw, never allocate) -------------------------------------------------
+  static constexpr std::uint32_t kMaxColliders = 32;
+  static constexpr std::uint32_t kMaxContactCandidates = 32768;
+  static constexpr std::uint32_t kMaxGrips = 4096;
+  static constexpr std::uint32_t kMaxSuctionFields = 4;
+  static constexpr std::uint32_t kMaxContactSurfaces = 16;
+  // Colliders and candidates for the next step (copied; extra entries beyond capacity are refused).
+  Status set_colliders(std::span<const ColliderCapsule> colliders);
+  Status set_contact_candidates(std::span<const ContactCandidate> candidates);
+  Status set_suction_fields(std::span<const SuctionField> fields);
+  std::uint32_t collider_count() const { return collider_count_; }
+  // Force the tissue of `surface` exerted on collider c during the last step (µN, from the contact
+  // multipliers averaged over the substeps); and summed over all surfaces.
+  Vec3 contact_force(std::uint32_t collider, std::uint32_t surface) const;
+  Vec3 contact_force(std::uint32_t collider) const;
+  // Deepest penetration any candidate had before it was resolved in the last step (mm).
+  double max_contact_depth(std::uint32_t collider) const;
+  // Grips: returns the grip index or kNone (full, stale triangle, bad data).
+  std::uint32_t add_grip(const GripDescription& grip);
+  Status set_grip_target(std::uint32_t grip, const Vec3& target_mm);
+  void release_grip(std::uint32_t grip);
+  bool grip_active(std::uint32_t grip) const { return grip < grips_.size() && grips_[grip].active; }
+  double grip_force(std::uint32_t grip) const { return grip < grips_.size() ? grips_[grip].last_force_un : 0.0; }
+  const GripDescription& grip(std::uint32_t g) const { return grips_.at(g).d; }
+  // Current position of the gripped surface point (its barycentric point on the deformed triangle).
+  Vec3 grip_point(std::uint32_t grip) const;
 
   // Advances the world by dt_s (0 < dt ≤ 0.02 s). Topology changes (tears) and broken attachments
   // happen at the end, at the step boundary. If the state would become non-finite, the whole step is
@@ -212,6 +284,10 @@ class TissueWorld {
   void project_springs(std::uint32_t s, double h, bool accumulate);
   void project_attachments(double h, bool accumulate);
   void project_wall();
+  void project_grips(double h, double fraction);
+  void project_contacts(double h, double fraction);
+  void apply_suction();
+  void break_grips();
   bool update_velocities(double h);
   void break_attachments();
   void find_overstrained();
@@ -232,6 +308,22 @@ class TissueWorld {
   std::vector<LocalForce> local_forces_;
   std::vector<TissueEvent> events_;
   std::vector<TearCandidate> tear_candidates_;
+
+  struct Grip {
+    GripDescription d;
+    Vec3 previous_target = Vec3::Zero();  // target at the start of the step (substeps interpolate)
+    bool active = false;
+    double last_force_un = 0.0;
+    double peak_force_un = 0.0;
+  };
+  std::vector<ColliderCapsule> colliders_;
+  std::uint32_t collider_count_ = 0;
+  std::vector<ContactCandidate> candidates_;
+  std::vector<SuctionField> suction_;
+  std::vector<Vec3> contact_force_;     // kMaxColliders × kMaxContactSurfaces, accumulated
+  std::vector<double> contact_depth_;   // kMaxColliders
+  std::vector<Grip> grips_;
+  std::uint32_t grip_high_water_ = 0;
   std::uint64_t step_count_ = 0;
   double time_s_ = 0.0;
 };

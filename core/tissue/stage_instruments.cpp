@@ -1,0 +1,222 @@
+// Step stage: instruments acting inside the substeps — contact with kinematic capsules (tissue is
+// pushed out, never crossed), grips (forceps grasps and laser adhesions at barycentric surface
+// points), and their force estimates from the constraint multipliers. The broad phase that picks the
+// candidate triangles lives in core/collision (FCL); here everything is exact and allocation-free.
+#include <algorithm>
+#include <cmath>
+
+#include "core/common/validate.hpp"
+#include "core/tissue/contact_geometry.hpp"
+#include "core/tissue/tissue_world.hpp"
+
+namespace vitreo::core {
+
+namespace {
+// In a crossing, only this many radii of the axis beyond the crossing point count toward the depth
+// (a long oblique shaft must not fling the triangle by its far end).
+constexpr double kCrossingReachRadii = 3.0;
+}  // namespace
+
+double TissueWorld::local_pressure_on(std::uint32_t surface, std::uint32_t vertex) const {
+  double p = 0.0;
+  for (const auto& lf : local_forces_) {
+    if (lf.d.surface != surface) continue;
+    for (std::size_t i = 0; i < lf.d.vertices.size(); ++i) {
+      if (lf.d.vertices[i] != vertex) continue;
+      p += lf.d.pressure_pa * lf.d.scale * (lf.d.weights.empty() ? 1.0 : lf.d.weights[i]);
+    }
+  }
+  return p;
+}
+
+Status TissueWorld::set_colliders(std::span<const ColliderCapsule> colliders) {
+  if (colliders.size() > kMaxColliders) return Status::error("set_colliders: more than kMaxColliders");
+  for (const auto& c : colliders) {
+    if (!is_finite(c.a0) || !is_finite(c.b0) || !is_finite(c.a1) || !is_finite(c.b1) || !std::isfinite(c.radius_mm) ||
+        c.radius_mm < 0.0 || c.radius_mm > 5.0) {
+      return Status::error("set_colliders: non-finite or out-of-range capsule");
+    }
+  }
+  std::copy(colliders.begin(), colliders.end(), colliders_.begin());
+  collider_count_ = static_cast<std::uint32_t>(colliders.size());
+  return Status::ok();
+}
+
+Status TissueWorld::set_contact_candidates(std::span<const ContactCandidate> candidates) {
+  candidates_.clear();
+  for (const auto& c : candidates) {
+    if (candidates_.size() == candidates_.capacity()) return Status::error("set_contact_candidates: capacity exceeded");
+    if (c.collider >= kMaxColliders || c.surface >= surfaces_.size() || c.surface >= kMaxContactSurfaces ||
+        !surfaces_[c.surface]->triangle_alive(c.triangle)) {
+      continue;  // stale after a topology change: dropped
+    }
+    candidates_.push_back(c);
+  }
+  return Status::ok();
+}
+
+Status TissueWorld::set_suction_fields(std::span<const SuctionField> fields) {
+  if (fields.size() > kMaxSuctionFields) return Status::error("set_suction_fields: too many fields");
+  suction_.clear();
+  for (const auto& f : fields) {
+    if (!is_finite(f.apex_mm) || !is_finite(f.axis) || !(f.axis.norm() > 0.0) || !std::isfinite(f.radius_mm) ||
+        !std::isfinite(f.pressure_pa) || f.radius_mm < 0.0 || f.pressure_pa < 0.0 || f.pressure_pa > 1e5) {
+      return Status::error("set_suction_fields: non-finite or out-of-range field");
+    }
+    SuctionField g = f;
+    g.axis.normalize();
+    suction_.push_back(g);
+  }
+  return Status::ok();
+}
+
+Vec3 TissueWorld::contact_force(std::uint32_t collider, std::uint32_t surface) const {
+  if (collider >= kMaxColliders || surface >= kMaxContactSurfaces) return Vec3::Zero();
+  return contact_force_[collider * kMaxContactSurfaces + surface];
+}
+
+Vec3 TissueWorld::contact_force(std::uint32_t collider) const {
+  Vec3 f = Vec3::Zero();
+  for (std::uint32_t s = 0; s < kMaxContactSurfaces; ++s) f += contact_force(collider, s);
+  return f;
+}
+
+double TissueWorld::max_contact_depth(std::uint32_t collider) const {
+  return collider < kMaxColliders ? contact_depth_[collider] : 0.0;
+}
+
+std::uint32_t TissueWorld::add_grip(const GripDescription& g) {
+  if (g.surface >= surfaces_.size()) return kNone;
+  const Surface& s = *surfaces_[g.surface];
+  if (!s.triangle_alive(g.triangle.index) || s.triangle_id(g.triangle.index) != g.triangle) return kNone;
+  if (!is_finite(g.bary) || !is_finite(g.target_mm) || std::abs(g.bary.sum() - 1.0) > 1e-6 || g.bary.minCoeff() < -1e-9) {
+    return kNone;
+  }
+  if (!(g.stiffness_un_per_mm > 0.0) || !std::isfinite(g.stiffness_un_per_mm) || !(g.break_force_un > 0.0)) return kNone;
+  for (std::uint32_t i = 0; i < grips_.size(); ++i) {
+    if (grips_[i].active) continue;
+    grips_[i] = {g, g.target_mm, true, 0.0, 0.0};
+    grip_high_water_ = std::max(grip_high_water_, i + 1);
+    for (auto v : s.triangle_vertices(g.triangle.index)) surfaces_[g.surface]->wake_vertex(v);
+    return i;
+  }
+  return kNone;
+}
+
+Status TissueWorld::set_grip_target(std::uint32_t grip, const Vec3& target) {
+  if (grip >= grips_.size() || !grips_[grip].active) return Status::error("set_grip_target: no such active grip");
+  if (!is_finite(target)) return Status::error("set_grip_target: non-finite target");
+  grips_[grip].d.target_mm = target;
+  const Surface& s = *surfaces_[grips_[grip].d.surface];
+  for (auto v : s.triangle_vertices(grips_[grip].d.triangle.index)) surfaces_[grips_[grip].d.surface]->wake_vertex(v);
+  return Status::ok();
+}
+
+void TissueWorld::release_grip(std::uint32_t grip) {
+  if (grip < grips_.size()) grips_[grip].active = false;
+}
+
+Vec3 TissueWorld::grip_point(std::uint32_t grip) const {
+  const Grip& g = grips_.at(grip);
+  const Surface& s = *surfaces_[g.d.surface];
+  const auto tv = s.triangle_vertices(g.d.triangle.index);
+  return g.d.bary[0] * s.position(tv[0]) + g.d.bary[1] * s.position(tv[1]) + g.d.bary[2] * s.position(tv[2]);
+}
+
+void TissueWorld::project_grips(double h, double fraction) {
+  const double h2 = h * h;
+  for (std::uint32_t i = 0; i < grip_high_water_; ++i) {
+    Grip& g = grips_[i];
+    if (!g.active) continue;
+    Surface& s = *surfaces_[g.d.surface];
+    auto view = s.solver_view();
+    const double* w = scratch_[g.d.surface].effective_inverse_mass.data();
+    const auto tv = view.tri_v[g.d.triangle.index];
+    const Vec3& b = g.d.bary;
+    const double wsum = w[tv[0]] * b[0] * b[0] + w[tv[1]] * b[1] * b[1] + w[tv[2]] * b[2] * b[2];
+    if (wsum == 0.0) continue;
+    const Vec3 target = g.previous_target + fraction * (g.d.target_mm - g.previous_target);
+    const Vec3 p = b[0] * view.x[tv[0]] + b[1] * view.x[tv[1]] + b[2] * view.x[tv[2]];
+    const double kh2 = g.d.stiffness_un_per_mm * h2;
+    const Vec3 dl = (target - p) * (kh2 / (wsum * kh2 + 1.0));
+    for (int k = 0; k < 3; ++k) view.x[tv[k]] += w[tv[k]] * b[k] * dl;
+    g.last_force_un = dl.norm() / h2;
+    g.peak_force_un = std::max(g.peak_force_un, g.last_force_un);
+  }
+}
+
+void TissueWorld::project_contacts(double h, double fraction) {
+  const double inv_h2 = 1.0 / (h * h);
+  const double share = 1.0 / settings_.substeps;  // forces are averaged over the substeps
+  for (const ContactCandidate& c : candidates_) {
+    const ColliderCapsule& cap = colliders_[c.collider];
+    const Vec3 a = cap.a0 + fraction * (cap.a1 - cap.a0);
+    const Vec3 b = cap.b0 + fraction * (cap.b1 - cap.b0);
+    const double r = cap.radius_mm;
+    Surface& s = *surfaces_[c.surface];
+    auto view = s.solver_view();
+    const double* w = scratch_[c.surface].effective_inverse_mass.data();
+    const auto tv = view.tri_v[c.triangle];
+    Vec3& x0 = view.x[tv[0]];
+    Vec3& x1 = view.x[tv[1]];
+    Vec3& x2 = view.x[tv[2]];
+    // Cheap reject: the triangle's bounding sphere against the capsule.
+    const Vec3 centroid = (x0 + x1 + x2) / 3.0;
+    const double tri_r2 = std::max({(x0 - centroid).squaredNorm(), (x1 - centroid).squaredNorm(), (x2 - centroid).squaredNorm()});
+    double sp = 0.0, tq = 0.0;
+    const double axis_d2 = contact::closest_segment_segment(a, b, centroid, centroid, sp, tq);
+    const double reach = r + std::sqrt(tri_r2);
+    if (axis_d2 > reach * reach) continue;
+
+    const auto st = contact::closest_segment_triangle(a, b, x0, x1, x2);
+    if (!st.crossing && st.distance >= r) continue;
+    Vec3 tri_n = (x1 - x0).cross(x2 - x0);
+    const double tri_n_len = tri_n.norm();
+    if (!(tri_n_len > 0.0)) continue;
+    tri_n /= tri_n_len;
+    Vec3 n;  // direction the tissue is pushed (from the instrument into the tissue)
+    double depth;
+    if (!st.crossing && st.distance > 1e-9) {
+      n = (st.on_triangle - st.on_segment) / st.distance;
+      depth = r - st.distance;
+    } else {
+      // The axis crosses the triangle: push it back to the side the instrument came from.
+      n = -static_cast<double>(c.side) * tri_n;
+      const Vec3 u = (b - a).norm() > 0.0 ? Vec3((b - a).normalized()) : Vec3(-n);
+      double beyond = 0.0;
+      for (const Vec3* e : {&a, &b}) {
+        const double along = (*e - st.on_segment).dot(u);
+        const double clipped = std::clamp(along, -kCrossingReachRadii * r, kCrossingReachRadii * r);
+        beyond = std::max(beyond, (clipped * u).dot(n));
+      }
+      depth = r + beyond;
+    }
+    const Vec3& bc = st.bary;
+    const double wsum = w[tv[0]] * bc[0] * bc[0] + w[tv[1]] * bc[1] * bc[1] + w[tv[2]] * bc[2] * bc[2];
+    if (wsum == 0.0) continue;
+    double& deepest = contact_depth_[c.collider];
+    deepest = std::max(deepest, depth);
+    const double lambda = depth / wsum;
+    x0 += (w[tv[0]] * bc[0] * lambda) * n;
+    x1 += (w[tv[1]] * bc[1] * lambda) * n;
+    x2 += (w[tv[2]] * bc[2] * lambda) * n;
+    contact_force_[c.collider * kMaxContactSurfaces + c.surface] -= n * (lambda * inv_h2 * share);
+  }
+}
+
+void TissueWorld::break_grips() {
+  for (std::uint32_t i = 0; i < grip_high_water_; ++i) {
+    Grip& g = grips_[i];
+    if (!g.active) continue;
+    const bool stale = !surfaces_[g.d.surface]->triangle_alive(g.d.triangle.index) ||
+                       surfaces_[g.d.surface]->triangle_id(g.d.triangle.index) != g.d.triangle;
+    if (stale || g.peak_force_un > g.d.break_force_un) {
+      g.active = false;
+      if (events_.size() < events_.capacity()) {
+        events_.push_back({TissueEventKind::kGripBroken, g.d.surface, i, g.d.target_mm, g.peak_force_un});
+      }
+    }
+  }
+}
+
+}  // namespace vitreo::core
