@@ -1,0 +1,347 @@
+// The only translation unit that includes FCL (~half a minute to compile: keep it that way).
+#include "core/collision/collision_scene.hpp"
+
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/capsule.h>
+#include <fcl/geometry/shape/ellipsoid.h>
+#include <fcl/narrowphase/distance.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "core/tissue/contact_geometry.hpp"
+
+namespace vitreo::core {
+
+namespace {
+
+using Box3 = Eigen::AlignedBox3d;
+
+struct Patch {
+  std::uint32_t surface = 0;
+  std::vector<std::uint32_t> triangles;
+  std::vector<std::uint32_t> blocks;  // vertex sleep blocks its triangles use
+  Box3 fat;
+  std::shared_ptr<fcl::Boxd> box;
+  std::unique_ptr<fcl::CollisionObjectd> object;
+};
+
+bool patch_awake(const Surface& s, const Patch& p) {
+  for (auto b : p.blocks) {
+    if (s.block_awake(b)) return true;
+  }
+  return false;
+}
+
+Box3 tight_box(const Surface& s, const Patch& p) {
+  Box3 box;
+  box.setEmpty();
+  for (auto t : p.triangles) {
+    if (!s.triangle_alive(t)) continue;
+    for (auto v : s.triangle_vertices(t)) box.extend(s.position(v));
+  }
+  return box;
+}
+
+Eigen::Matrix3d rotation_from_z(const Vec3& d) {
+  const Vec3 z = d.normalized();
+  return Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), z).toRotationMatrix();
+}
+
+fcl::Transform3d capsule_pose(const CapsuleShape& c) {
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  const Vec3 d = c.b - c.a;
+  if (d.norm() > 0.0) tf.linear() = rotation_from_z(d);
+  tf.translation() = 0.5 * (c.a + c.b);
+  return tf;
+}
+
+bool collect_patch(fcl::CollisionObjectd* /*query*/, fcl::CollisionObjectd* other, void* data) {
+  auto* hits = static_cast<std::vector<std::uint32_t>*>(data);
+  if (hits->size() < hits->capacity()) hits->push_back(static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(other->getUserData())));
+  return false;  // keep going
+}
+
+}  // namespace
+
+struct CollisionScene::Impl {
+  std::vector<Patch> patches;
+  std::vector<std::uint64_t> surface_versions;
+  std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager;
+  std::shared_ptr<fcl::Boxd> query_box;
+  std::unique_ptr<fcl::CollisionObjectd> query;
+  std::vector<std::uint32_t> hits;
+  std::uint64_t steps = 0;
+
+  void build(const TissueWorld& world, const CollisionOptions& o) {
+    patches.clear();
+    surface_versions.clear();
+    manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+    for (std::uint32_t si = 0; si < world.surface_count(); ++si) {
+      const Surface& s = world.surface(si);
+      surface_versions.push_back(s.topology_version());
+      std::unordered_map<std::int64_t, std::uint32_t> cell_to_patch;
+      for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+        if (!s.triangle_alive(t)) continue;
+        const auto tv = s.triangle_vertices(t);
+        const Vec3 c = (s.rest_position(tv[0]) + s.rest_position(tv[1]) + s.rest_position(tv[2])) / 3.0;
+        auto cell = [&](double x) { return static_cast<std::int64_t>(std::floor(x / o.patch_cell_mm)) & 0x1FFFFF; };
+        const std::int64_t key = (cell(c.x()) << 42) | (cell(c.y()) << 21) | cell(c.z());
+        auto [it, inserted] = cell_to_patch.try_emplace(key, static_cast<std::uint32_t>(patches.size()));
+        if (inserted) {
+          patches.emplace_back();
+          patches.back().surface = si;
+        }
+        Patch& p = patches[it->second];
+        p.triangles.push_back(t);
+        for (auto v : tv) {
+          const std::uint32_t b = v / Surface::kSleepBlock;
+          if (std::find(p.blocks.begin(), p.blocks.end(), b) == p.blocks.end()) p.blocks.push_back(b);
+        }
+      }
+    }
+    std::vector<fcl::CollisionObjectd*> objects;
+    for (std::size_t i = 0; i < patches.size(); ++i) {
+      Patch& p = patches[i];
+      p.fat = tight_box(world.surface(p.surface), p);
+      p.fat.min().array() -= o.margin_mm;
+      p.fat.max().array() += o.margin_mm;
+      p.box = std::make_shared<fcl::Boxd>(p.fat.sizes());
+      p.object = std::make_unique<fcl::CollisionObjectd>(p.box);
+      p.object->setTranslation(p.fat.center());
+      p.object->computeAABB();
+      p.object->setUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)));
+      objects.push_back(p.object.get());
+    }
+    manager->registerObjects(objects);
+    manager->setup();
+    hits.clear();
+    hits.reserve(patches.size());
+  }
+
+  void refit(const Surface& s, Patch& p, double margin) {
+    const Box3 tight = tight_box(s, p);
+    if (tight.isEmpty() || p.fat.contains(tight)) return;
+    p.fat = tight;
+    p.fat.min().array() -= margin;
+    p.fat.max().array() += margin;
+    p.box->side = p.fat.sizes();
+    p.box->computeLocalAABB();
+    p.object->setTranslation(p.fat.center());
+    p.object->computeAABB();
+    manager->update(p.object.get());
+  }
+
+  // Patches whose fat box overlaps `box` (FCL broad phase).
+  void query_box_hits(const Box3& box) {
+    hits.clear();
+    query_box->side = box.sizes().cwiseMax(1e-6);
+    query_box->computeLocalAABB();
+    query->setTranslation(box.center());
+    query->computeAABB();
+    manager->collide(query.get(), &hits, collect_patch);
+    std::sort(hits.begin(), hits.end());  // deterministic order
+  }
+};
+
+CollisionScene::CollisionScene(const TissueWorld& world, CollisionOptions options, RigidAnatomy anatomy)
+    : impl_(std::make_unique<Impl>()), options_(options), anatomy_(anatomy) {
+  if (!(options_.patch_cell_mm > 0.0) || !(options_.margin_mm >= 0.0) || options_.far_refit_period == 0) {
+    throw InvalidArgument("collision: patch_cell_mm > 0, margin_mm >= 0 and far_refit_period >= 1 required");
+  }
+  impl_->query_box = std::make_shared<fcl::Boxd>(1.0, 1.0, 1.0);
+  impl_->query = std::make_unique<fcl::CollisionObjectd>(impl_->query_box);
+  impl_->build(world, options_);
+  stats_.patches = static_cast<std::uint32_t>(impl_->patches.size());
+}
+
+CollisionScene::~CollisionScene() = default;
+
+void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCapsule> colliders, std::vector<ContactCandidate>& out) {
+  Impl& m = *impl_;
+  out.clear();
+  stats_ = {};
+  bool rebuild = world.surface_count() != m.surface_versions.size();
+  for (std::uint32_t si = 0; si < world.surface_count() && !rebuild; ++si) {
+    rebuild = world.surface(si).topology_version() != m.surface_versions[si];
+  }
+  if (rebuild) m.build(world, options_);
+  stats_.patches = static_cast<std::uint32_t>(m.patches.size());
+
+  // Swept boxes of the colliders, and the larger "near" region around them.
+  constexpr std::uint32_t kMax = TissueWorld::kMaxColliders;
+  std::array<Box3, kMax> swept;
+  const std::uint32_t n = static_cast<std::uint32_t>(std::min<std::size_t>(colliders.size(), kMax));
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const auto& c = colliders[k];
+    Box3 b(c.a0);
+    b.extend(c.b0).extend(c.a1).extend(c.b1);
+    b.min().array() -= c.radius_mm;
+    b.max().array() += c.radius_mm;
+    swept[k] = b;
+  }
+  const std::uint64_t step = m.steps++;
+  for (std::size_t i = 0; i < m.patches.size(); ++i) {
+    Patch& p = m.patches[i];
+    const Surface& s = world.surface(p.surface);
+    if (!patch_awake(s, p)) continue;  // asleep: has not moved
+    bool near = false;
+    for (std::uint32_t k = 0; k < n && !near; ++k) {
+      Box3 b = swept[k];
+      b.min().array() -= options_.near_mm;
+      b.max().array() += options_.near_mm;
+      near = b.intersects(p.fat);
+    }
+    if (near || (step + i) % options_.far_refit_period == 0) {
+      m.refit(s, p, options_.margin_mm);
+      ++stats_.patches_refit;
+    }
+  }
+
+  // Tissue moves a little within the step: triangles this close to a sweep are candidates too.
+  constexpr double kSlack_mm = 0.1;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const auto& c = colliders[k];
+    m.query_box_hits(swept[k]);
+    stats_.patches_hit += static_cast<std::uint32_t>(m.hits.size());
+    Box3 reach = swept[k];
+    reach.min().array() -= kSlack_mm;
+    reach.max().array() += kSlack_mm;
+    for (auto pi : m.hits) {
+      const Patch& p = m.patches[pi];
+      const Surface& s = world.surface(p.surface);
+      for (auto t : p.triangles) {
+        if (!s.triangle_alive(t)) continue;
+        const auto tv = s.triangle_vertices(t);
+        const Vec3& x0 = s.position(tv[0]);
+        const Vec3& x1 = s.position(tv[1]);
+        const Vec3& x2 = s.position(tv[2]);
+        Box3 tb(x0);
+        tb.extend(x1).extend(x2);
+        if (!tb.intersects(reach)) continue;
+        if (out.size() == out.capacity()) {
+          stats_.candidates_truncated = true;
+          continue;
+        }
+        // The side the instrument is on before the step; a crossing (which the solver never
+        // leaves behind) falls back to the port end, which is always on the entry side.
+        const Vec3 normal = (x1 - x0).cross(x2 - x0);
+        const auto st = contact::closest_segment_triangle(c.a0, c.b0, x0, x1, x2);
+        const double side = st.crossing || st.distance < 1e-9 ? normal.dot(c.a0 - x0) : normal.dot(st.on_segment - st.on_triangle);
+        out.push_back({k, p.surface, t, static_cast<std::int8_t>(side < 0.0 ? -1 : 1)});
+      }
+    }
+  }
+  stats_.candidates = static_cast<std::uint32_t>(out.size());
+}
+
+SurfacePoint CollisionScene::nearest_point(const TissueWorld& world, const Vec3& center, double radius, std::uint32_t mask) const {
+  SurfacePoint best;
+  best.distance = radius;
+  Box3 box(center);
+  box.min().array() -= radius;
+  box.max().array() += radius;
+  impl_->query_box_hits(box);
+  for (auto pi : impl_->hits) {
+    const Patch& p = impl_->patches[pi];
+    if (p.surface < 32 && !(mask & (1u << p.surface))) continue;
+    const Surface& s = world.surface(p.surface);
+    for (auto t : p.triangles) {
+      if (!s.triangle_alive(t)) continue;
+      const auto tv = s.triangle_vertices(t);
+      Vec3 bary;
+      const Vec3 q = contact::closest_on_triangle(center, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), bary);
+      const double d = (q - center).norm();
+      if (d <= best.distance) {
+        best = {true, p.surface, t, bary, q, d};
+      }
+    }
+  }
+  return best;
+}
+
+RayHit CollisionScene::raycast(const TissueWorld& world, const Vec3& origin, const Vec3& direction, double max_t, std::uint32_t mask) const {
+  RayHit best;
+  best.t = max_t;
+  const Vec3 d = direction.normalized();
+  const Vec3 inv = d.cwiseInverse();
+  for (const Patch& p : impl_->patches) {
+    if (p.surface < 32 && !(mask & (1u << p.surface))) continue;
+    // Slab test against the fat box.
+    double t0 = 0.0, t1 = best.t;
+    for (int a = 0; a < 3; ++a) {
+      double ta = (p.fat.min()[a] - origin[a]) * inv[a];
+      double tb = (p.fat.max()[a] - origin[a]) * inv[a];
+      if (std::isnan(ta) || std::isnan(tb)) { ta = -std::numeric_limits<double>::infinity(); tb = -ta; }
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+    }
+    if (t0 > t1) continue;
+    const Surface& s = world.surface(p.surface);
+    for (auto t : p.triangles) {
+      if (!s.triangle_alive(t)) continue;
+      const auto tv = s.triangle_vertices(t);
+      Vec3 bary;
+      const double th = contact::ray_triangle(origin, d, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), bary);
+      if (th >= 0.0 && th < best.t) {
+        best = {true, p.surface, t, bary, origin + th * d, th};
+      }
+    }
+  }
+  return best;
+}
+
+void CollisionScene::wake_near(TissueWorld& world, const Vec3& center, double radius) const {
+  Box3 box(center);
+  box.min().array() -= radius;
+  box.max().array() += radius;
+  impl_->query_box_hits(box);
+  const double r2 = radius * radius;
+  for (auto pi : impl_->hits) {
+    const Patch& p = impl_->patches[pi];
+    Surface& s = world.surface(p.surface);
+    for (auto t : p.triangles) {
+      if (!s.triangle_alive(t)) continue;
+      for (auto v : s.triangle_vertices(t)) {
+        if (!s.vertex_awake(v) && (s.position(v) - center).squaredNorm() <= r2) s.wake_vertex(v);
+      }
+    }
+  }
+}
+
+double CollisionScene::capsule_distance(const CapsuleShape& p, const CapsuleShape& q, Vec3* witness) const {
+  const fcl::Capsuled cp(p.radius_mm, std::max((p.b - p.a).norm(), 1e-9));
+  const fcl::Capsuled cq(q.radius_mm, std::max((q.b - q.a).norm(), 1e-9));
+  fcl::DistanceRequestd request(true);
+  fcl::DistanceResultd result;
+  fcl::distance(&cp, capsule_pose(p), &cq, capsule_pose(q), request, result);
+  double dist = result.min_distance;
+  Vec3 w = 0.5 * (result.nearest_points[0] + result.nearest_points[1]);
+  if (!(dist > 0.0)) {
+    // Overlapping: FCL reports no depth for capsule pairs; the axes' distance gives it exactly.
+    double s = 0, t = 0;
+    const double d2 = contact::closest_segment_segment(p.a, p.b, q.a, q.b, s, t);
+    dist = std::sqrt(d2) - p.radius_mm - q.radius_mm;
+    w = 0.5 * ((p.a + s * (p.b - p.a)) + (q.a + t * (q.b - q.a)));
+  }
+  if (witness) *witness = w;
+  return dist;
+}
+
+double CollisionScene::lens_distance(const CapsuleShape& c) const {
+  if (!anatomy_.has_lens) return std::numeric_limits<double>::infinity();
+  const fcl::Ellipsoidd lens(anatomy_.lens_semi_axes_mm);
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.translation() = anatomy_.lens_center_mm;
+  const fcl::Capsuled cap(c.radius_mm, std::max((c.b - c.a).norm(), 1e-9));
+  fcl::DistanceRequestd request(false);
+  fcl::DistanceResultd result;
+  fcl::distance(&cap, capsule_pose(c), &lens, tf, request, result);
+  return result.min_distance;
+}
+
+}  // namespace vitreo::core

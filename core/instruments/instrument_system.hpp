@@ -1,0 +1,250 @@
+#pragma once
+// The instruments in the eye, stepped with the tissue: each step the rig sets every instrument's
+// input (tracked pose, handle, pedal) and calls step(); the system works out the eye's rotation, the
+// instruments' collision shapes, hands the tissue contact candidates (FCL broad phase,
+// core/collision) and the grasps, suction and adhesions to the TissueWorld, steps it, and reports
+// contact forces, iatrogenic events, laser burns, the fluid level and the eye rotation.
+//
+// Cutting and removal are topology changes, which belong to core/topology: the blades, scissors and
+// vitrector describe what they sweep or draw in (BladeSweep, RemovalRequest) and hand it to a
+// TopologyActions implementation at the step boundary; without one the requests are still listed
+// each step for the rig and the tests.
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/collision/collision_scene.hpp"
+#include "core/common/status.hpp"
+#include "core/instruments/instrument.hpp"
+#include "core/tissue/tissue_world.hpp"
+
+namespace vitreo::core {
+
+// The quad a blade's sharp edge swept during one step: the edge (a, b) at the start of the step and
+// at its end. A cut is everything the quad crosses. For scissors the edge is the closed part of the
+// blades (hinge → crossing point), so the quad is the strip closed during the step.
+struct BladeSweep {
+  std::uint32_t instrument = 0;
+  InstrumentKind kind = InstrumentKind::kBlade;
+  Vec3 a0 = Vec3::Zero(), b0 = Vec3::Zero();  // edge at the start of the step (eye frame)
+  Vec3 a1 = Vec3::Zero(), b1 = Vec3::Zero();  // edge at the end of the step
+};
+
+// Vitrector removal for one step: tissue inside the removal hemisphere (radius, in front of the port
+// along its normal) is cut away at the cut rate; suction (the outer hemisphere) is already applied.
+struct RemovalRequest {
+  std::uint32_t instrument = 0;
+  Vec3 port_center_mm = Vec3::Zero();
+  Vec3 port_normal = Vec3::UnitZ();
+  double removal_radius_mm = 0.0;
+  double suction_radius_mm = 0.0;
+  double vacuum = 0.0;        // 0..1 of maximum (pedal)
+  double cut_rate_hz = 0.0;   // 0: not cutting
+  double dt_s = 0.0;
+};
+
+// Consumer of cuts and removals: core/topology implements it (the adapter point). Called after
+// TissueWorld::step, at the step boundary, once per sweep/request.
+class TopologyActions {
+ public:
+  virtual ~TopologyActions() = default;
+  virtual void cut(TissueWorld& world, const BladeSweep& sweep) = 0;
+  virtual void remove(TissueWorld& world, const RemovalRequest& request) = 0;
+};
+
+enum class InstrumentEventKind : std::uint8_t {
+  kExcessiveRetinaForce,  // magnitude: contact force on the retina (µN)
+  kUnintendedTear,        // a tear in the retina; magnitude: strain
+  kLaserOnDetachedRetina, // burn without adhesion; magnitude: clearance from the choroid (mm)
+  kLightTooClose,         // the light pipe within the safe distance of the macula; magnitude: distance
+  kLightToxicity,         // the macular light dose passed the limit; magnitude: dose (J/cm²)
+  kInstrumentCollision,   // two instruments touch; `other` is the second; magnitude: depth (mm)
+  kLensTouch,             // magnitude: depth (mm)
+  kWallContact,           // the tip pressed into the globe wall; magnitude: depth (mm)
+  kGrasp,                 // forceps closed on tissue; magnitude: distance to the grasp point (mm)
+  kGraspLost,             // the grasped tissue pulled out of the jaws / tore away; magnitude: force
+  kRelease,
+  kAttachmentBroken,      // passed on from the tissue; magnitude: force (µN)
+  kLaserBurn,             // magnitude: burn diameter (mm)
+};
+const char* to_string(InstrumentEventKind k);
+
+struct InstrumentEvent {
+  InstrumentEventKind kind;
+  std::uint32_t instrument;  // kNone when not tied to one
+  std::uint32_t other;       // second instrument, surface, … (kNone when unused)
+  Vec3 position_mm;
+  double magnitude;
+};
+
+struct BurnSpot {
+  std::uint32_t instrument = 0;
+  std::uint32_t surface = 0;
+  TriangleId triangle;
+  Vec3 bary = Vec3::Zero();
+  Vec3 position_mm = Vec3::Zero();  // where it was burnt (eye frame); the spot moves with the tissue
+  double diameter_mm = 0.0;
+  double power_mw = 0.0;
+  double duration_s = 0.0;
+  bool adhered = false;
+  double time_s = 0.0;
+};
+
+// A retinal break with subretinal fluid behind it (the detachment's local force).
+struct DrainageSite {
+  std::uint32_t local_force = 0;
+  Vec3 break_point_mm = Vec3::Zero();
+  double reach_mm = 1.5;  // the needle drains when its tip is this close to the break
+};
+
+struct InstrumentDescription {
+  InstrumentKind kind = InstrumentKind::kLightPipe;
+  Gauge gauge = Gauge::k23;
+  std::uint32_t port = 0;  // index into InstrumentSceneOptions::ports_mm
+  InstrumentDimensions dimensions;
+};
+
+struct InstrumentSceneOptions {
+  std::vector<Vec3> ports_mm;  // sclerotomies, eye frame
+  std::uint32_t retina_surface = kNone;
+  std::optional<Vec3> macula_mm;
+  std::vector<DrainageSite> drainage_sites;
+  RigidAnatomy anatomy;
+  CollisionOptions collision;
+
+  // Eye rotation (quasi-static): the sclera at a port pushed sideways by the shaft (stiffness) and
+  // the orbit's restoring torque (per radian).
+  double port_stiffness_un_per_mm = 2e5;
+  double eye_rotation_stiffness_un_mm_per_rad = 5e6;
+
+  double retina_force_limit_un = 3000.0;  // contact force above which the retina is damaged
+  double grasp_radius_mm = 0.15;          // tissue this close to the jaws' grasp point is grasped
+  double grasp_close_actuation = 0.8;     // handle closed past this: grasp; below release_actuation: let go
+  double release_actuation = 0.5;
+  double grasp_stiffness_un_per_mm = 1e5;
+  double grasp_break_force_un = 8000.0;   // tissue slips out of the jaws above this
+  double adhesion_gap_mm = 0.05;          // retina within this of the choroid can adhere
+  double adhesion_max_pressure_pa = 1.0;  // ... unless a detachment force above this acts on it
+  double adhesion_stiffness_un_per_mm = 2e5;
+  double laser_spot_mm = 0.2;             // aiming-beam spot; burn diameter scales with energy
+  double laser_reference_energy_mj = 20.0;
+  double vitrector_suction_pa = 300.0;    // at full vacuum
+  double vitrector_field_mm = 1.5;        // suction hemisphere radius at full vacuum
+  double vitrector_removal_mm = 0.3;
+  double vitrector_cut_rate_hz = 125.0;   // 7500 cuts/min
+  double aspiration_level_rate_mm_s = 2.0;
+  double drainage_rate_per_s = 0.5;       // detachment scale drained per second at full aspiration
+  double light_half_angle_deg = 40.0;
+  double light_safe_distance_mm = 4.0;
+  double light_dose_limit_j_cm2 = 10.0;
+};
+
+struct InstrumentState {
+  InstrumentDescription description;
+  InstrumentInput input;
+  InstrumentFrame frame;
+  TipGeometry tip;
+  bool inside = false;
+  Vec3 contact_force_un = Vec3::Zero();  // tissue on the instrument, all surfaces (µN)
+  double retina_force_un = 0.0;          // magnitude of the retina's part
+  std::uint32_t grip = kNone;            // active grasp (forceps)
+  Vec3 grip_local = Vec3::Zero();        // grasped point in the jaw frame
+  double grip_force_un = 0.0;
+  // Endolaser aiming beam: from the tip to the hit (or max range).
+  bool aim_hit = false;
+  Vec3 aim_point_mm = Vec3::Zero();
+};
+
+struct EyeRotation {
+  Vec3 rotation_vector_rad = Vec3::Zero();  // eye relative to the fixture (axis × angle)
+  Vec3 torque_un_mm = Vec3::Zero();         // of the ports on the eye
+  bool from_rig = false;                    // set by set_eye_fixture_rotation
+  Quat rotation() const;
+};
+
+struct LightExposure {
+  bool active = false;
+  Vec3 apex_mm = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();
+  double half_angle_rad = 0.0;
+  double macula_distance_mm = std::numeric_limits<double>::infinity();
+  double macula_dose_j_cm2 = 0.0;
+};
+
+struct InstrumentStepReport {
+  StepReport tissue;
+  std::uint32_t candidates = 0;
+  std::uint32_t patches_refit = 0;
+};
+
+class InstrumentSystem {
+ public:
+  // Throws InvalidArgument on bad options (ports out of range, non-finite data).
+  InstrumentSystem(TissueWorld& world, InstrumentSceneOptions options, std::vector<InstrumentDescription> instruments);
+  ~InstrumentSystem();
+
+  void set_topology(TopologyActions* topology) { topology_ = topology; }
+  // Per step, before step(): never throws, refuses non-finite input.
+  Status set_input(std::uint32_t instrument, const InstrumentInput& input);
+  // A rig whose mock eye really rotates reports it here; otherwise (nullopt) the rotation is simulated.
+  void set_eye_fixture_rotation(std::optional<Quat> rotation);
+  void set_air_infusion(bool on) { air_infusion_ = on; }
+
+  InstrumentStepReport step(double dt_s);
+
+  // ---- Outputs of the last step ----------------------------------------------------------------
+  std::uint32_t instrument_count() const { return static_cast<std::uint32_t>(state_.size()); }
+  const InstrumentState& instrument(std::uint32_t i) const { return state_.at(i); }
+  const std::vector<InstrumentEvent>& events() const { return events_; }
+  const std::vector<BurnSpot>& burns() const { return burns_; }
+  const std::vector<BladeSweep>& blade_sweeps() const { return sweeps_; }
+  const std::vector<RemovalRequest>& removal_requests() const { return removals_; }
+  const EyeRotation& eye_rotation() const { return eye_; }
+  const LightExposure& light() const { return light_; }
+  double fluid_level_z_mm() const { return world_.environment().fluid_level_z_mm; }
+  const CollisionStats& collision_stats() const { return collision_->stats(); }
+  const CollisionScene& collision() const { return *collision_; }
+  // Current position of a burn spot on the deformed tissue.
+  Vec3 burn_position(const BurnSpot& burn) const;
+
+ private:
+  void solve_eye_rotation();
+  void place_instruments();
+  void update_grasps();
+  void update_laser(double dt);
+  void update_fluid(double dt);
+  void update_light(double dt);
+  void rigid_contacts();
+  void after_step(const StepReport& report, double dt);
+  void emit(InstrumentEventKind kind, std::uint32_t instrument, std::uint32_t other, const Vec3& p, double magnitude);
+
+  TissueWorld& world_;
+  InstrumentSceneOptions options_;
+  std::unique_ptr<CollisionScene> collision_;
+  TopologyActions* topology_ = nullptr;
+  std::vector<InstrumentState> state_;
+  std::vector<InstrumentInput> previous_input_;
+  std::vector<TipGeometry> previous_tip_;
+  std::vector<std::uint8_t> was_inside_;
+  std::optional<Quat> rig_rotation_;
+  EyeRotation eye_;
+  bool air_infusion_ = false;
+  LightExposure light_;
+  bool light_close_reported_ = false;
+  bool light_dose_reported_ = false;
+
+  std::vector<ColliderCapsule> colliders_;
+  std::vector<std::uint32_t> collider_owner_;
+  std::vector<ContactCandidate> candidates_;
+  std::vector<SuctionField> suction_;
+  std::vector<InstrumentEvent> events_;
+  std::vector<BurnSpot> burns_;
+  std::vector<BladeSweep> sweeps_;
+  std::vector<RemovalRequest> removals_;
+  std::vector<std::uint8_t> pair_touching_, lens_touching_, wall_touching_, retina_overloaded_;
+};
+
+}  // namespace vitreo::core
