@@ -59,9 +59,10 @@ fcl::Transform3d capsule_pose(const CapsuleShape& c) {
   return tf;
 }
 
-bool collect_patch(fcl::CollisionObjectd* /*query*/, fcl::CollisionObjectd* other, void* data) {
+// FCL's dynamic AABB tree calls back with (tree object, query object).
+bool collect_patch(fcl::CollisionObjectd* patch, fcl::CollisionObjectd* /*query*/, void* data) {
   auto* hits = static_cast<std::vector<std::uint32_t>*>(data);
-  if (hits->size() < hits->capacity()) hits->push_back(static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(other->getUserData())));
+  if (hits->size() < hits->capacity()) hits->push_back(static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(patch->getUserData())));
   return false;  // keep going
 }
 

@@ -369,6 +369,7 @@ void InstrumentSystem::rigid_contacts() {
 
 InstrumentStepReport InstrumentSystem::step(double dt) {
   InstrumentStepReport report;
+  if (probe_) probe_(0, probe_user_);
   events_.clear();
   sweeps_.clear();
   removals_.clear();
@@ -412,8 +413,11 @@ InstrumentStepReport InstrumentSystem::step(double dt) {
   report.candidates = collision_->stats().candidates;
   report.patches_refit = collision_->stats().patches_refit;
 
+  if (probe_) probe_(1, probe_user_);
   report.tissue = world_.step(dt);
+  if (probe_) probe_(2, probe_user_);
   after_step(report.tissue, dt);
+  if (probe_) probe_(3, probe_user_);
   return report;
 }
 

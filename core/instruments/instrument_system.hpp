@@ -195,6 +195,15 @@ class InstrumentSystem {
 
   InstrumentStepReport step(double dt_s);
 
+  // Optional timing hook for benchmarks and the rig's profiler (core reads no clock): called with
+  // phase 0 at the start of step(), 1 after collision and the instruments' own work, 2 after the
+  // tissue step (whose substeps resolve the contacts), 3 at the end.
+  using PhaseProbe = void (*)(int phase, void* user);
+  void set_phase_probe(PhaseProbe probe, void* user) {
+    probe_ = probe;
+    probe_user_ = user;
+  }
+
   // ---- Outputs of the last step ----------------------------------------------------------------
   std::uint32_t instrument_count() const { return static_cast<std::uint32_t>(state_.size()); }
   const InstrumentState& instrument(std::uint32_t i) const { return state_.at(i); }
@@ -225,6 +234,8 @@ class InstrumentSystem {
   InstrumentSceneOptions options_;
   std::unique_ptr<CollisionScene> collision_;
   TopologyActions* topology_ = nullptr;
+  PhaseProbe probe_ = nullptr;
+  void* probe_user_ = nullptr;
   std::vector<InstrumentState> state_;
   std::vector<InstrumentInput> previous_input_;
   std::vector<TipGeometry> previous_tip_;

@@ -1,0 +1,576 @@
+// Instruments on small scenes with scripted poses, checked against analytic references.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/anatomy/retina_cap.hpp"
+#include "core/instruments/instrument_system.hpp"
+#include "test_meshes.hpp"
+
+using namespace vitreo::core;
+
+namespace {
+
+constexpr double kDt = 1e-3;
+
+// A flat sheet of `size` mm centred on (0, 0, z), `cells` per side, its border anchored.
+SurfaceDescription sheet(double size, int cells, double z, double tear_strain = INFINITY) {
+  SurfaceDescription d;
+  d.mesh = test::rectangle(size, size, cells, cells);
+  for (auto& p : d.mesh.positions) p += Vec3(-size / 2, -size / 2, z);
+  d.material.tear_strain = tear_strain;
+  d.contained_by_globe = false;
+  return d;
+}
+
+void anchor_border(Surface& s, double size) {
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+    const Vec3& p = s.rest_position(v);
+    if (std::abs(std::abs(p.x()) - size / 2) < 1e-9 || std::abs(std::abs(p.y()) - size / 2) < 1e-9) {
+      EXPECT_TRUE(s.set_fixed(s.vertex_id(v), true));
+    }
+  }
+}
+
+Environment no_pressure() {
+  Environment e;
+  e.apply_pressure = false;
+  return e;
+}
+
+SolverSettings no_sleep() {
+  SolverSettings s;
+  s.sleeping = false;
+  return s;
+}
+
+// Straight down the z axis through a port above the scene.
+InstrumentInput down_to(double tip_z, double actuation = 0.0) {
+  InstrumentInput in = InstrumentInput::through_port(Vec3(0, 0, 10), -Vec3::UnitZ(), 10.0 - tip_z);
+  in.actuation = actuation;
+  return in;
+}
+
+std::size_t count(const std::vector<InstrumentEvent>& events, InstrumentEventKind k) {
+  return static_cast<std::size_t>(std::count_if(events.begin(), events.end(), [&](const auto& e) { return e.kind == k; }));
+}
+
+}  // namespace
+
+TEST(Instruments, GaugesAndPivotKinematics) {
+  EXPECT_NEAR(2 * shaft_radius_mm(Gauge::k20), 0.9081, 1e-9);
+  EXPECT_NEAR(2 * shaft_radius_mm(Gauge::k23), 0.6414, 1e-9);
+  EXPECT_NEAR(2 * shaft_radius_mm(Gauge::k25), 0.5144, 1e-9);
+  const Vec3 port(0, 8, 8);
+  const Vec3 dir = Vec3(0, -1, -1.5).normalized();
+  const InstrumentInput in = InstrumentInput::through_port(port, dir, 7.0, 0.3);
+  const InstrumentFrame f = make_frame(in.tip_fixture_mm, in.axis_fixture, in.twist_rad, port);
+  EXPECT_NEAR(f.inserted_mm, 7.0, 1e-12);
+  EXPECT_NEAR((f.port - port).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(f.u.dot(f.v), 0.0, 1e-12);
+  EXPECT_NEAR(f.v.norm(), 1.0, 1e-12);
+  // The shaft capsule runs from the port to the tip.
+  const TipGeometry g = tip_geometry(InstrumentKind::kDrainageNeedle, Gauge::k25, f, in);
+  ASSERT_EQ(g.count, 1);
+  EXPECT_NEAR((g.parts[0].a - port).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((g.parts[0].b - f.tip).norm(), 0.0, 1e-12);
+  // Twist rolls the frame about the shaft by exactly the twist angle.
+  const InstrumentFrame f0 = make_frame(in.tip_fixture_mm, in.axis_fixture, 0.0, port);
+  EXPECT_NEAR(std::acos(std::clamp(f0.v.dot(f.v), -1.0, 1.0)), 0.3, 1e-9);
+  // Forceps jaws close with the handle.
+  InstrumentInput open = in, closed = in;
+  closed.actuation = 1.0;
+  const TipGeometry go = tip_geometry(InstrumentKind::kForceps, Gauge::k23, f, open);
+  const TipGeometry gc = tip_geometry(InstrumentKind::kForceps, Gauge::k23, f, closed);
+  EXPECT_GT(go.jaw_gap_mm, 0.5);
+  EXPECT_EQ(gc.jaw_gap_mm, 0.0);
+}
+
+TEST(Instruments, ForcepsLiftAMembraneAtTheGraspedPoint) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t m = world.add_surface(sheet(6.0, 30, 0.0));
+  anchor_border(world.surface(m), 6.0);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
+  // Off the mesh's vertices on purpose: the grasp is at the point between the jaws, not a vertex.
+  const Vec3 offset(0.07, -0.04, 0.0);
+  auto at = [&](double z, double act) {
+    InstrumentInput in = down_to(z, act);
+    in.tip_fixture_mm += offset;
+    return in;
+  };
+  for (int i = 0; i < 50; ++i) {  // descend to just above the membrane, jaws open
+    ASSERT_TRUE(sys.set_input(0, at(1.0 - 0.95 * i / 49.0, 0.0)));
+    sys.step(kDt);
+  }
+  for (int i = 0; i <= 20; ++i) {  // close the handle
+    ASSERT_TRUE(sys.set_input(0, at(0.05, i / 20.0)));
+    sys.step(kDt);
+  }
+  ASSERT_NE(sys.instrument(0).grip, kNone);
+  const GripDescription g = world.grip(sys.instrument(0).grip);
+  const Vec3 grasped = world.grip_point(sys.instrument(0).grip);
+  EXPECT_NEAR(grasped.x(), offset.x(), 0.02);
+  EXPECT_NEAR(grasped.y(), offset.y(), 0.02);
+  EXPECT_GT(g.bary.minCoeff(), -1e-12);
+  for (int i = 1; i <= 200; ++i) {  // lift 2 mm at 10 mm/s
+    ASSERT_TRUE(sys.set_input(0, at(0.05 + 2.0 * i / 200.0, 1.0)));
+    sys.step(kDt);
+  }
+  ASSERT_NE(sys.instrument(0).grip, kNone);
+  const auto& st = sys.instrument(0);
+  const Vec3 jaw = st.tip.hinge + st.grip_local.x() * st.frame.u + st.grip_local.y() * st.frame.v + st.grip_local.z() * st.frame.w;
+  const Vec3 tissue = world.grip_point(st.grip);
+  EXPECT_LT((tissue - jaw).norm(), 0.1);
+  EXPECT_NEAR(tissue.z(), grasped.z() + 2.0, 0.1);
+  EXPECT_NEAR(tissue.x(), grasped.x(), 0.1);
+  EXPECT_NEAR(tissue.y(), grasped.y(), 0.1);
+  EXPECT_GT(st.grip_force_un, 0.0);
+  // Open the handle: the membrane is let go.
+  ASSERT_TRUE(sys.set_input(0, at(2.05, 0.0)));
+  sys.step(kDt);
+  EXPECT_EQ(sys.instrument(0).grip, kNone);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kRelease), 1u);
+}
+
+// A tool driven into a membrane at up to 50 mm/s either pushes it ahead or tears/cuts it (event):
+// it never ends with its shaft through the intact membrane.
+class NoPassThrough : public ::testing::TestWithParam<std::tuple<double, double, double>> {};
+
+TEST_P(NoPassThrough, TheShaftNeverEndsBeyondTheTissueWithoutATear) {
+  const auto [speed, tilt_deg, tear_strain] = GetParam();
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t m = world.add_surface(sheet(8.0, 40, 0.0, tear_strain));
+  anchor_border(world.surface(m), 8.0);
+  const double tilt = tilt_deg * std::numbers::pi / 180.0;
+  const Vec3 dir(std::sin(tilt), 0.0, -std::cos(tilt));
+  const Vec3 port = Vec3::Zero() - 10.0 * dir;
+  InstrumentSceneOptions o;
+  o.ports_mm = {port};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k25, 0, {}}});
+  const double start = 9.0, end = 12.5;  // insertion: 1 mm before the membrane to 2.5 mm past it
+  const int steps = static_cast<int>((end - start) / (speed * kDt));
+  std::size_t tears = 0;
+  for (int i = 0; i <= steps; ++i) {
+    ASSERT_TRUE(sys.set_input(0, InstrumentInput::through_port(port, dir, start + (end - start) * i / steps)));
+    const auto r = sys.step(kDt);
+    ASSERT_TRUE(r.tissue.ok);
+    tears += r.tissue.tears;
+  }
+  const auto& st = sys.instrument(0);
+  // Is the tissue still ahead of the tip? The first hit of the ray from the port along the shaft
+  // must lie beyond the tip (the membrane was pushed, not crossed).
+  const RayHit hit = sys.collision().raycast(world, port, dir, 30.0);
+  const bool through = !hit.hit || hit.t < st.frame.inserted_mm;
+  if (std::isinf(tear_strain)) {
+    EXPECT_EQ(tears, 0u);
+    EXPECT_FALSE(through) << "speed " << speed << " tilt " << tilt_deg;
+    EXPECT_GT(hit.t, st.frame.inserted_mm + 0.5 * shaft_radius_mm(Gauge::k25));
+    // The membrane pushes back on the instrument, against its motion.
+    EXPECT_LT(st.contact_force_un.dot(dir), 0.0);
+  } else if (through) {
+    EXPECT_GT(tears, 0u) << "passed through without a tear";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Speeds, NoPassThrough,
+                         ::testing::Values(std::make_tuple(10.0, 0.0, INFINITY), std::make_tuple(50.0, 0.0, INFINITY),
+                                           std::make_tuple(50.0, 35.0, INFINITY), std::make_tuple(50.0, 0.0, 0.3),
+                                           std::make_tuple(30.0, 20.0, 0.3)));
+
+TEST(Instruments, VitrectorSuctionActsOnlyInsideItsHemisphere) {
+  // Loose tiny triangles around the port: each moves only under its own forces.
+  SurfaceDescription d;
+  d.contained_by_globe = false;
+  d.material.tear_strain = INFINITY;
+  const Vec3 tip(0, 0, 0);
+  for (int i = -5; i <= 5; ++i) {
+    for (int j = -5; j <= 5; ++j) {
+      for (int k = -4; k <= 4; ++k) {
+        const Vec3 c = tip + Vec3(0.4 * i, 0.4 * j, 0.35 * k);
+        if (c.head<2>().norm() < 0.7 && c.z() > -0.6) continue;  // clear of the shaft
+        const auto b = static_cast<std::uint32_t>(d.mesh.positions.size());
+        d.mesh.positions.push_back(c + Vec3(0.02, 0, 0));
+        d.mesh.positions.push_back(c + Vec3(-0.01, 0.017, 0));
+        d.mesh.positions.push_back(c + Vec3(-0.01, -0.017, 0));
+        d.mesh.triangles.push_back({b, b + 1, b + 2});
+      }
+    }
+  }
+  Environment env = no_pressure();
+  env.gravity_mm_s2 = Vec3::Zero();
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), env, no_sleep());
+  const std::uint32_t s = world.add_surface(d);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+  InstrumentInput in = down_to(0.0);
+  in.pedal = 1.0;
+  ASSERT_TRUE(sys.set_input(0, in));
+  sys.step(kDt);
+  const auto& st = sys.instrument(0);
+  const Vec3 apex = st.tip.port_center, axis = st.tip.port_normal;
+  const double radius = o.vitrector_field_mm;
+  ASSERT_EQ(sys.removal_requests().size(), 1u);
+  EXPECT_NEAR(sys.removal_requests()[0].suction_radius_mm, radius, 1e-12);
+  EXPECT_GT(sys.removal_requests()[0].cut_rate_hz, 0.0);
+  std::vector<Vec3> start(world.surface(s).vertex_slots());
+  const Surface& surf = world.surface(s);
+  for (std::uint32_t v = 0; v < surf.vertex_slots(); ++v) start[v] = d.mesh.positions[v];
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+  }
+  int inside = 0, outside = 0;
+  for (std::uint32_t t = 0; t < surf.triangle_slots(); ++t) {
+    const auto tv = surf.triangle_vertices(t);
+    const Vec3 c0 = (start[tv[0]] + start[tv[1]] + start[tv[2]]) / 3.0;
+    const Vec3 c1 = (surf.position(tv[0]) + surf.position(tv[1]) + surf.position(tv[2])) / 3.0;
+    const Vec3 rel = c0 - apex;
+    const bool in_field = rel.norm() < radius - 0.03 && rel.dot(axis) > 0.03;
+    const bool out_field = rel.norm() > radius + 0.03 || rel.dot(axis) < -0.03;
+    if (in_field) {
+      ++inside;
+      EXPECT_LT((c1 - apex).norm(), rel.norm() - 1e-4) << "not drawn toward the port";
+    } else if (out_field) {
+      ++outside;
+      EXPECT_LT((c1 - c0).norm(), 1e-12) << "moved outside the field";
+    }
+  }
+  EXPECT_GT(inside, 10);
+  EXPECT_GT(outside, 100);
+}
+
+TEST(Instruments, LaserBurnIsCentredOnTheExactRayHit) {
+  // Flat sheet, oblique ray: the analytic hit is on the plane z = 0.
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  world.add_surface(sheet(6.0, 13, 0.0));
+  anchor_border(world.surface(0), 6.0);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(3, 1, 8)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+  const Vec3 dir = Vec3(-0.37, -0.11, -1.0).normalized();
+  InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], dir, 5.0);
+  ASSERT_TRUE(sys.set_input(0, in));
+  sys.step(kDt);
+  ASSERT_TRUE(sys.instrument(0).aim_hit);
+  in.trigger = true;
+  ASSERT_TRUE(sys.set_input(0, in));
+  sys.step(kDt);
+  ASSERT_EQ(sys.burns().size(), 1u);
+  const Vec3 o0 = in.tip_fixture_mm;
+  const Vec3 analytic = o0 + (-o0.z() / dir.z()) * dir;
+  EXPECT_LT((sys.burns()[0].position_mm - analytic).norm(), 0.010);
+  EXPECT_LT((sys.instrument(0).aim_point_mm - analytic).norm(), 0.010);
+  // Holding the trigger does not fire again; a new press does.
+  sys.step(kDt);
+  EXPECT_EQ(sys.burns().size(), 1u);
+}
+
+TEST(Instruments, LaserAdheresAttachedRetinaOnlyAndBurnSizeFollowsEnergy) {
+  RetinaCapOptions ro;
+  ro.retina_vertices = 20000;
+  RetinaCapScene scene = build_retina_cap(ro);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 10.4, 6.0)};
+  o.retina_surface = scene.retina;
+  InstrumentSystem sys(scene.world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+  const double R = scene.world.surface(scene.retina).position(0).norm();
+  auto fire = [&](const Vec3& target, double power, double duration, bool on_sphere) {
+    const Vec3 dir = (target - o.ports_mm[0]).normalized();
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], dir, 8.0);
+    in.laser_power_mw = power;
+    in.laser_duration_s = duration;
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    in.trigger = true;
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    // Analytic hit of the ray with the sphere the retina lies on.
+    const Vec3 p0 = in.tip_fixture_mm;
+    const double b = p0.dot(dir), c = p0.squaredNorm() - R * R;
+    const Vec3 analytic = p0 + (-b + std::sqrt(b * b - c)) * dir;
+    ASSERT_FALSE(sys.burns().empty());
+    const Vec3 burn = sys.burns().back().position_mm;
+    // Where the retina still lies on the sphere, the analytic hit; where the detachment force has
+    // begun to lift it, at least exactly on the ray.
+    if (on_sphere) {
+      EXPECT_LT((burn - analytic).norm(), 0.010);
+    }
+    EXPECT_LT(((burn - p0) - (burn - p0).dot(dir) * dir).norm(), 1e-9);
+  };
+  // Attached retina, temporal-inferior of the pole (outside the detachment on −x).
+  fire(Vec3(4.0, -3.0, -11.0).normalized() * R, 200.0, 0.1, true);
+  EXPECT_TRUE(sys.burns().back().adhered);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kLaserOnDetachedRetina), 0u);
+  const double d1 = sys.burns().back().diameter_mm;
+  // Inside the detachment: no adhesion, an event.
+  const double th = ro.detachment_center_deg * std::numbers::pi / 180.0;
+  fire(Vec3(-std::sin(th), 0.0, -std::cos(th)) * R, 400.0, 0.2, false);
+  EXPECT_FALSE(sys.burns().back().adhered);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kLaserOnDetachedRetina), 1u);
+  EXPECT_NEAR(sys.burns().back().diameter_mm / d1, 2.0, 1e-9);  // 4× the energy: twice the diameter
+}
+
+TEST(Instruments, FluidLevelFollowsTheAspiratingNeedleUnderAirInfusion) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure());
+  world.add_surface(sheet(2.0, 4, -11.0));
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k20, 0, {}}});
+  InstrumentInput in = down_to(2.0);
+  in.pedal = 1.0;
+  // No air infusion: the chamber stays full of fluid.
+  for (int i = 0; i < 100; ++i) {
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+  }
+  EXPECT_TRUE(std::isinf(sys.fluid_level_z_mm()));
+  // Air in: the level starts at the top of the chamber and falls at the aspiration rate (2 mm/s at
+  // full pedal) until it reaches the needle (thesis ch. 2.6.2.4).
+  sys.set_air_infusion(true);
+  sys.step(kDt);
+  EXPECT_NEAR(sys.fluid_level_z_mm(), 12.0 - 2.0 * kDt, 0.011);
+  for (int i = 0; i < 5000; ++i) {
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    ASSERT_GE(sys.fluid_level_z_mm(), 2.0);
+  }
+  EXPECT_NEAR(sys.fluid_level_z_mm(), 2.0, 0.011);
+  // The needle descends at 1 mm/s (slower than the aspiration rate): the level follows it.
+  for (int i = 1; i <= 4000; ++i) {
+    InstrumentInput cur = down_to(2.0 - 4.0 * i / 4000.0);
+    cur.pedal = 1.0;
+    ASSERT_TRUE(sys.set_input(0, cur));
+    sys.step(kDt);
+    ASSERT_NEAR(sys.fluid_level_z_mm(), cur.tip_fixture_mm.z(), 0.011);
+  }
+  // Raised again, or not aspirating: the level stays where the needle took it.
+  in = down_to(0.0);
+  in.pedal = 1.0;
+  for (int i = 0; i < 100; ++i) {
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+  }
+  EXPECT_NEAR(sys.fluid_level_z_mm(), -2.0, 0.011);
+}
+
+TEST(Instruments, SubretinalFluidDrainsThroughABreakOnlyUnderGas) {
+  RetinaCapOptions ro;
+  ro.retina_vertices = 2000;
+  const double th = ro.detachment_center_deg * std::numbers::pi / 180.0;
+  const Vec3 brk = Vec3(-std::sin(th), 0.0, -std::cos(th)) * 11.0;  // above the detached retina
+  auto run = [&](bool gas) {
+    RetinaCapScene scene = build_retina_cap(ro);
+    InstrumentSceneOptions o;
+    o.ports_mm = {Vec3(0, 10.4, 6.0)};
+    o.retina_surface = scene.retina;
+    o.drainage_sites = {{scene.detachment_force, brk, 1.5}};
+    InstrumentSystem sys(scene.world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k20, 0, {}}});
+    if (gas) {
+      Environment env = scene.world.environment();
+      env.fluid_level_z_mm = brk.z() - 2.0;  // exchange done down to below the break
+      EXPECT_TRUE(scene.world.set_environment(env));
+      sys.set_air_infusion(true);
+    }
+    const Vec3 dir = (brk - o.ports_mm[0]).normalized();
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], dir, (brk - o.ports_mm[0]).norm());
+    in.pedal = 1.0;
+    for (int i = 0; i < 1000; ++i) {
+      EXPECT_TRUE(sys.set_input(0, in));
+      sys.step(kDt);
+    }
+    return scene.world.local_force_scale(scene.detachment_force);
+  };
+  EXPECT_EQ(run(false), 1.0);
+  EXPECT_NEAR(run(true), 1.0 - 0.5 * 1.0, 0.01);  // drainage rate 0.5/s for 1 s at full aspiration
+}
+
+// A membrane on an anchored sheet, bound by attachments, lifted by forceps: weak ones let go,
+// strong ones hold (the tissue tears instead, starting at the grasp).
+class PeelAttachment : public ::testing::TestWithParam<double> {};
+
+TEST_P(PeelAttachment, WeakLetsGoStrongHolds) {
+  const double strength = GetParam();
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t base = world.add_surface(sheet(4.0, 20, -0.02));
+  for (std::uint32_t v = 0; v < world.surface(base).vertex_slots(); ++v) {
+    ASSERT_TRUE(world.surface(base).set_fixed(world.surface(base).vertex_id(v), true));
+  }
+  const std::uint32_t mem = world.add_surface(sheet(4.0, 20, 0.0, 0.3));
+  std::uint32_t attachments = 0;
+  for (std::uint32_t v = 0; v < world.surface(mem).vertex_slots(); v += 2) {
+    AttachmentDescription a;
+    a.surface_a = mem;
+    a.vertex_a = v;
+    a.surface_b = base;
+    a.vertex_b = v;
+    a.break_force_un = strength;
+    world.add_attachment(a);
+    ++attachments;
+  }
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
+  for (int i = 0; i <= 20; ++i) {
+    ASSERT_TRUE(sys.set_input(0, down_to(0.05, i / 20.0)));
+    sys.step(kDt);
+  }
+  ASSERT_NE(sys.instrument(0).grip, kNone);
+  const Vec3 grasp = world.grip_point(sys.instrument(0).grip);
+  std::size_t broken = 0, tears = 0;
+  Vec3 first_tear = Vec3::Constant(1e9);
+  for (int i = 1; i <= 400; ++i) {
+    ASSERT_TRUE(sys.set_input(0, down_to(0.05 + 2.0 * i / 400.0, 1.0)));
+    const auto r = sys.step(kDt);
+    broken += r.tissue.attachments_broken;
+    for (const auto& e : world.events()) {
+      if (e.kind == TissueEventKind::kTear && tears++ == 0) first_tear = e.position_mm;
+    }
+  }
+  if (std::isinf(strength)) {
+    EXPECT_EQ(broken, 0u);
+    for (std::uint32_t a = 0; a < attachments; ++a) EXPECT_TRUE(world.attachment_intact(a));
+    ASSERT_GT(tears, 0u);  // something had to give: the membrane, where it is pulled
+    EXPECT_LT((first_tear - grasp).head<2>().norm(), 0.6);
+  } else {
+    EXPECT_GT(broken, 0u);
+    EXPECT_EQ(sys.instrument(0).grip == kNone, false);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Strengths, PeelAttachment, ::testing::Values(20.0, INFINITY));
+
+TEST(Instruments, ShaftOffItsPortRotatesTheEye) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure());
+  world.add_surface(sheet(2.0, 4, -11.0));
+  InstrumentSceneOptions o;
+  const Vec3 port(0, 0, 11.5);
+  o.ports_mm = {port};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}});
+  // The shaft's line passes 0.3 mm beside the port (+x): the sclera is dragged toward it.
+  InstrumentInput in = InstrumentInput::through_port(port + Vec3(0.3, 0, 0), -Vec3::UnitZ(), 8.0);
+  ASSERT_TRUE(sys.set_input(0, in));
+  for (int i = 0; i < 5; ++i) sys.step(kDt);
+  const EyeRotation& e = sys.eye_rotation();
+  EXPECT_FALSE(e.from_rig);
+  // Linearised equilibrium: ke·θ = p × kp·(offset − θ × p) ⇒ θ_y = kp·|p|·0.3 / (ke + kp·|p|²).
+  const double kp = o.port_stiffness_un_per_mm, ke = o.eye_rotation_stiffness_un_mm_per_rad, p = port.norm();
+  EXPECT_NEAR(e.rotation_vector_rad.y(), kp * p * 0.3 / (ke + kp * p * p), 1e-4);
+  EXPECT_NEAR(e.rotation_vector_rad.x(), 0.0, 1e-9);
+  // The port moved toward the shaft.
+  EXPECT_GT((e.rotation() * port).x(), 0.0);
+  // A rig that measures its mock eye's rotation overrides the simulation.
+  sys.set_eye_fixture_rotation(Quat(Eigen::AngleAxisd(0.1, Vec3::UnitX())));
+  sys.step(kDt);
+  EXPECT_TRUE(sys.eye_rotation().from_rig);
+  EXPECT_NEAR(sys.eye_rotation().rotation_vector_rad.x(), 0.1, 1e-12);
+}
+
+TEST(Instruments, CollisionsBetweenInstrumentsLensAndWallAreReported) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure());
+  world.add_surface(sheet(2.0, 4, -11.0));
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(-8, 0, 8), Vec3(8, 0, 8)};
+  o.anatomy.has_lens = true;
+  o.anatomy.lens_center_mm = Vec3(0, 0, 8.5);
+  o.anatomy.lens_semi_axes_mm = Vec3(4.5, 4.5, 2.0);
+  InstrumentSystem sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}, {InstrumentKind::kVitrector, Gauge::k23, 1, {}}});
+  // Both tips meet at (0, 0, 0).
+  auto toward = [&](int port, const Vec3& target, double extra) {
+    const Vec3 dir = (target - o.ports_mm[port]).normalized();
+    return InstrumentInput::through_port(o.ports_mm[port], dir, (target - o.ports_mm[port]).norm() + extra);
+  };
+  ASSERT_TRUE(sys.set_input(0, toward(0, Vec3(0, 0, 0), 0.0)));
+  ASSERT_TRUE(sys.set_input(1, toward(1, Vec3(0, 0, 3), 0.0)));
+  sys.step(kDt);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kInstrumentCollision), 0u);
+  ASSERT_TRUE(sys.set_input(1, toward(1, Vec3(0, 0, 0.2), 0.0)));
+  sys.step(kDt);
+  ASSERT_EQ(count(sys.events(), InstrumentEventKind::kInstrumentCollision), 1u);
+  sys.step(kDt);  // still touching: reported once
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kInstrumentCollision), 0u);
+  // Into the lens, and into the globe wall.
+  ASSERT_TRUE(sys.set_input(1, toward(1, Vec3(0, 0, 7.0), 0.0)));
+  ASSERT_TRUE(sys.set_input(0, toward(0, Vec3(0, 0, -11.9), 0.0)));
+  sys.step(kDt);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kLensTouch), 1u);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kWallContact), 1u);
+}
+
+TEST(Instruments, LightPipeNearTheMaculaAccumulatesDose) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure());
+  world.add_surface(sheet(2.0, 4, 5.0));
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 8, 8)};
+  o.macula_mm = Vec3(0, 0, -12);
+  InstrumentSystem sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}});
+  const Vec3 dir = (*o.macula_mm - o.ports_mm[0]).normalized();
+  const double full = (*o.macula_mm - o.ports_mm[0]).norm();
+  InstrumentInput far = InstrumentInput::through_port(o.ports_mm[0], dir, full - 10.0);
+  ASSERT_TRUE(sys.set_input(0, far));
+  sys.step(1e-3);
+  const double d0 = sys.light().macula_dose_j_cm2;
+  // Analytic: irradiance P/(π (d tan α)²), mW/mm² → 0.1 W/cm².
+  const double a = o.light_half_angle_deg * std::numbers::pi / 180.0;
+  const double expected = 10.0 / (std::numbers::pi * std::pow(10.0 * std::tan(a), 2)) * 0.1 * 1e-3;
+  EXPECT_NEAR(d0, expected, 1e-9 * expected + 1e-15);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kLightTooClose), 0u);
+  InstrumentInput close = InstrumentInput::through_port(o.ports_mm[0], dir, full - 2.0);
+  ASSERT_TRUE(sys.set_input(0, close));
+  sys.step(1e-3);
+  EXPECT_EQ(count(sys.events(), InstrumentEventKind::kLightTooClose), 1u);
+  EXPECT_GT(sys.light().macula_dose_j_cm2 - d0, 20.0 * d0);
+}
+
+TEST(Instruments, BladesAndScissorsReportTheirSweptEdges) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure());
+  world.add_surface(sheet(2.0, 4, -11.0));
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10), Vec3(3, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}, {InstrumentKind::kScissors, Gauge::k23, 1, {}}});
+  InstrumentInput blade = down_to(2.0);
+  InstrumentInput sc = InstrumentInput::through_port(o.ports_mm[1], -Vec3::UnitZ(), 8.0);
+  ASSERT_TRUE(sys.set_input(0, blade));
+  ASSERT_TRUE(sys.set_input(1, sc));
+  sys.step(kDt);
+  EXPECT_TRUE(sys.blade_sweeps().empty());
+  blade = down_to(1.9);
+  sc.actuation = 0.5;
+  ASSERT_TRUE(sys.set_input(0, blade));
+  ASSERT_TRUE(sys.set_input(1, sc));
+  sys.step(kDt);
+  ASSERT_EQ(sys.blade_sweeps().size(), 2u);
+  const BladeSweep& b = sys.blade_sweeps()[0];
+  EXPECT_NEAR((b.b0 - Vec3(0, 0, 2.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((b.b1 - Vec3(0, 0, 1.9)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((b.a1 - b.b1).norm(), InstrumentDimensions{}.blade_length_mm, 1e-12);
+  const BladeSweep& s = sys.blade_sweeps()[1];
+  EXPECT_EQ(s.kind, InstrumentKind::kScissors);
+  EXPECT_NEAR((s.b1 - s.a1).norm(), 0.5 * InstrumentDimensions{}.jaw_length_mm, 1e-12);
+  EXPECT_NEAR((s.b0 - s.a0).norm(), 0.0, 1e-12);
+}
+
+TEST(Instruments, ExcessiveForceOnTheRetinaIsReported) {
+  RetinaCapOptions ro;
+  ro.retina_vertices = 2000;
+  ro.detachment = false;
+  RetinaCapScene scene = build_retina_cap(ro);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 11.5)};
+  o.retina_surface = scene.retina;
+  InstrumentSystem sys(scene.world, o, {{InstrumentKind::kLightPipe, Gauge::k20, 0, {}}});
+  std::size_t events = 0;
+  double peak = 0.0;
+  for (int i = 0; i <= 400; ++i) {  // down onto the posterior pole and 0.5 mm into it at 10 mm/s
+    const double depth = 21.5 + 2.0 * std::min(i, 250) / 250.0;
+    ASSERT_TRUE(sys.set_input(0, InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), depth)));
+    sys.step(kDt);
+    events += count(sys.events(), InstrumentEventKind::kExcessiveRetinaForce);
+    peak = std::max(peak, sys.instrument(0).retina_force_un);
+  }
+  EXPECT_GE(events, 1u);
+  EXPECT_GT(peak, o.retina_force_limit_un);
+}
