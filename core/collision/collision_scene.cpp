@@ -253,6 +253,7 @@ SurfacePoint CollisionScene::nearest_point(const TissueWorld& world, const Vec3&
     for (auto t : p.triangles) {
       if (!s.triangle_alive(t)) continue;
       const auto tv = s.triangle_vertices(t);
+      if (s.is_fixed(tv[0]) && s.is_fixed(tv[1]) && s.is_fixed(tv[2])) continue;  // anchored: cannot be taken
       Vec3 bary;
       const Vec3 q = contact::closest_on_triangle(center, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), bary);
       const double d = (q - center).norm();

@@ -268,24 +268,29 @@ void InstrumentSystem::update_laser(double /*dt*/) {
 
 void InstrumentSystem::update_fluid(double dt) {
   Environment env = world_.environment();
-  double level = env.fluid_level_z_mm;
+  // The world's level may have been set directly (a scene loaded mid-exchange): never above it.
+  if (env.fluid_level_z_mm < fluid_level_ - 0.05 || !std::isfinite(env.fluid_level_z_mm)) fluid_level_ = env.fluid_level_z_mm;
+  double level = fluid_level_;
   if (air_infusion_) {
     const Vec3& c = world_.wall().center();
     const double top = c.z() + world_.wall().radius_toward(Vec3::UnitZ());
     if (!(level < top)) level = top;
+    // The aspirating needle takes fluid from its tip: the level falls toward it while air comes in.
     for (const auto& st : state_) {
       if (st.description.kind != InstrumentKind::kDrainageNeedle || !st.inside || st.input.pedal <= 0.0) continue;
       const double z = st.frame.tip.z();
       if (z < level) level = std::max(z, level - options_.aspiration_level_rate_mm_s * st.input.pedal * dt);
     }
   }
+  fluid_level_ = level;
+  constexpr double kPushStep_mm = 0.05;
   if (level != env.fluid_level_z_mm &&
-      (!std::isfinite(env.fluid_level_z_mm) || std::abs(level - env.fluid_level_z_mm) >= 0.01 || !air_infusion_)) {
+      (!std::isfinite(env.fluid_level_z_mm) || !std::isfinite(level) || std::abs(level - env.fluid_level_z_mm) >= kPushStep_mm)) {
     env.fluid_level_z_mm = level;
     (void)world_.set_environment(env);
   }
   // Subretinal fluid drains through a break only while the break is under gas (thesis 2.6.2.4).
-  const double now_level = world_.environment().fluid_level_z_mm;
+  const double now_level = fluid_level_;
   for (const auto& site : options_.drainage_sites) {
     if (!(site.break_point_mm.z() > now_level)) continue;
     for (const auto& st : state_) {

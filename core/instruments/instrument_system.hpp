@@ -213,7 +213,9 @@ class InstrumentSystem {
   const std::vector<RemovalRequest>& removal_requests() const { return removals_; }
   const EyeRotation& eye_rotation() const { return eye_; }
   const LightExposure& light() const { return light_; }
-  double fluid_level_z_mm() const { return world_.environment().fluid_level_z_mm; }
+  // The fluid–gas boundary (+infinity: all fluid). The tissue world's environment follows it in
+  // 0.05 mm increments (each change re-evaluates buoyancy everywhere, so it is not pushed every step).
+  double fluid_level_z_mm() const { return fluid_level_; }
   const CollisionStats& collision_stats() const { return collision_->stats(); }
   const CollisionScene& collision() const { return *collision_; }
   // Current position of a burn spot on the deformed tissue.
@@ -243,6 +245,7 @@ class InstrumentSystem {
   std::optional<Quat> rig_rotation_;
   EyeRotation eye_;
   bool air_infusion_ = false;
+  double fluid_level_ = std::numeric_limits<double>::infinity();
   LightExposure light_;
   bool light_close_reported_ = false;
   bool light_dose_reported_ = false;

@@ -95,7 +95,13 @@ std::uint32_t TissueWorld::add_grip(const GripDescription& g) {
   if (!(g.stiffness_un_per_mm > 0.0) || !std::isfinite(g.stiffness_un_per_mm) || !(g.break_force_un > 0.0)) return kNone;
   for (std::uint32_t i = 0; i < grips_.size(); ++i) {
     if (grips_[i].active) continue;
-    grips_[i] = {g, g.target_mm, true, 0.0, 0.0};
+    grips_[i] = Grip{};
+    grips_[i].d = g;
+    grips_[i].previous_target = g.target_mm;
+    grips_[i].active = true;
+    grips_[i].vertices = s.triangle_vertices(g.triangle.index);
+    grips_[i].last_point = g.bary[0] * s.position(grips_[i].vertices[0]) + g.bary[1] * s.position(grips_[i].vertices[1]) +
+                           g.bary[2] * s.position(grips_[i].vertices[2]);
     grip_high_water_ = std::max(grip_high_water_, i + 1);
     for (auto v : s.triangle_vertices(g.triangle.index)) surfaces_[g.surface]->wake_vertex(v);
     return i;
@@ -129,6 +135,7 @@ void TissueWorld::project_grips(double h, double fraction) {
     Grip& g = grips_[i];
     if (!g.active) continue;
     Surface& s = *surfaces_[g.d.surface];
+    if (!s.triangle_alive(g.d.triangle.index)) continue;
     auto view = s.solver_view();
     const double* w = scratch_[g.d.surface].effective_inverse_mass.data();
     const auto tv = view.tri_v[g.d.triangle.index];
@@ -201,6 +208,44 @@ void TissueWorld::project_contacts(double h, double fraction) {
     x1 += (w[tv[1]] * bc[1] * lambda) * n;
     x2 += (w[tv[2]] * bc[2] * lambda) * n;
     contact_force_[c.collider * kMaxContactSurfaces + c.surface] -= n * (lambda * inv_h2 * share);
+  }
+}
+
+// A tear (or cut) that splits a gripped triangle frees its slot: the grip follows the tissue to the
+// new triangle around the old one's vertices that holds the gripped point, so the jaws keep their
+// hold while the tissue tears at the grasp.
+void TissueWorld::rebind_grips() {
+  for (std::uint32_t i = 0; i < grip_high_water_; ++i) {
+    Grip& g = grips_[i];
+    if (!g.active) continue;
+    Surface& s = *surfaces_[g.d.surface];
+    const bool current = s.triangle_alive(g.d.triangle.index) && s.triangle_id(g.d.triangle.index) == g.d.triangle;
+    if (current) {
+      const auto tv = s.triangle_vertices(g.d.triangle.index);
+      g.last_point = g.d.bary[0] * s.position(tv[0]) + g.d.bary[1] * s.position(tv[1]) + g.d.bary[2] * s.position(tv[2]);
+      continue;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    std::uint32_t best_t = kNone;
+    Vec3 best_bary = Vec3::Zero();
+    for (auto v : g.vertices) {
+      if (!s.vertex_alive(v)) continue;
+      s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+        const auto tv = s.triangle_vertices(t);
+        Vec3 bary;
+        const Vec3 q = contact::closest_on_triangle(g.last_point, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), bary);
+        const double d = (q - g.last_point).squaredNorm();
+        if (d < best) {
+          best = d;
+          best_t = t;
+          best_bary = bary;
+        }
+      });
+    }
+    if (best_t == kNone) continue;  // break_grips reports it next step
+    g.d.triangle = s.triangle_id(best_t);
+    g.d.bary = best_bary;
+    g.vertices = s.triangle_vertices(best_t);
   }
 }
 

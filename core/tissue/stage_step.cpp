@@ -273,6 +273,7 @@ StepReport TissueWorld::step(double dt_s) {
   break_attachments();
   break_grips();
   tear_overstrained();
+  rebind_grips();
   finish_sleep();
   for (const auto& e : events_) {
     if (e.kind == TissueEventKind::kTear) ++report.tears;

@@ -11,6 +11,7 @@
 // ("Small Steps", Macklin et al. 2019): compliance makes stiffness independent of step size and
 // iteration count, and small substeps keep it stable at dt = 1 ms for every stiffness in the
 // material range, and when tiny triangles appear after a cut.
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -288,6 +289,7 @@ class TissueWorld {
   void project_contacts(double h, double fraction);
   void apply_suction();
   void break_grips();
+  void rebind_grips();
   bool update_velocities(double h);
   void break_attachments();
   void find_overstrained();
@@ -312,6 +314,8 @@ class TissueWorld {
   struct Grip {
     GripDescription d;
     Vec3 previous_target = Vec3::Zero();  // target at the start of the step (substeps interpolate)
+    Vec3 last_point = Vec3::Zero();       // where the gripped point was at the end of the last step
+    std::array<std::uint32_t, 3> vertices{};  // of the gripped triangle (to follow it through tears)
     bool active = false;
     double last_force_un = 0.0;
     double peak_force_un = 0.0;

@@ -394,8 +394,12 @@ class PeelAttachment : public ::testing::TestWithParam<double> {};
 
 TEST_P(PeelAttachment, WeakLetsGoStrongHolds) {
   const double strength = GetParam();
-  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
-  const std::uint32_t base = world.add_surface(sheet(4.0, 20, -0.02));
+  // Enough substeps that the membrane and the attachments reach their nominal stiffness at this
+  // mesh size (see core/README.md, solver accuracy).
+  SolverSettings settings = no_sleep();
+  settings.substeps = 8;
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), settings);
+  const std::uint32_t base = world.add_surface(sheet(4.0, 20, 0.0));  // coincident: instance vertices
   for (std::uint32_t v = 0; v < world.surface(base).vertex_slots(); ++v) {
     ASSERT_TRUE(world.surface(base).set_fixed(world.surface(base).vertex_id(v), true));
   }
