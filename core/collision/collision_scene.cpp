@@ -8,6 +8,7 @@
 #include <fcl/narrowphase/distance.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -75,6 +76,7 @@ struct CollisionScene::Impl {
   std::shared_ptr<fcl::Boxd> query_box;
   std::unique_ptr<fcl::CollisionObjectd> query;
   std::vector<std::uint32_t> hits;
+  std::vector<std::uint64_t> refit_stamp, candidate_stamp;
   std::uint64_t steps = 0;
 
   void build(const TissueWorld& world, const CollisionOptions& o) {
@@ -171,70 +173,90 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
   }
   if (rebuild) m.build(world, options_);
   stats_.patches = static_cast<std::uint32_t>(m.patches.size());
+  const std::uint64_t step = ++m.steps;
 
-  // Swept boxes of the colliders, and the larger "near" region around them.
-  constexpr std::uint32_t kMax = TissueWorld::kMaxColliders;
-  std::array<Box3, kMax> swept;
-  const std::uint32_t n = static_cast<std::uint32_t>(std::min<std::size_t>(colliders.size(), kMax));
-  for (std::uint32_t k = 0; k < n; ++k) {
-    const auto& c = colliders[k];
-    Box3 b(c.a0);
-    b.extend(c.b0).extend(c.a1).extend(c.b1);
-    b.min().array() -= c.radius_mm;
-    b.max().array() += c.radius_mm;
-    swept[k] = b;
-  }
-  const std::uint64_t step = m.steps++;
-  for (std::size_t i = 0; i < m.patches.size(); ++i) {
-    Patch& p = m.patches[i];
+  // Each collider's sweep, cut into short pieces so that a long oblique shaft is bounded by a few
+  // small boxes instead of one large one.
+  constexpr double kChunk_mm = 1.5;
+  constexpr double kSlack_mm = 0.1;  // tissue moves a little within the step
+  const std::uint32_t n = static_cast<std::uint32_t>(std::min<std::size_t>(colliders.size(), TissueWorld::kMaxColliders));
+  auto for_each_chunk = [&](const ColliderCapsule& c, double inflate, auto&& f) {
+    const double len = std::max((c.b1 - c.a1).norm(), (c.b0 - c.a0).norm());
+    const int pieces = std::clamp(static_cast<int>(std::ceil(len / kChunk_mm)), 1, 64);
+    for (int k = 0; k < pieces; ++k) {
+      const double s0 = static_cast<double>(k) / pieces, s1 = static_cast<double>(k + 1) / pieces;
+      Box3 b(c.a0 + s0 * (c.b0 - c.a0));
+      b.extend(c.a0 + s1 * (c.b0 - c.a0)).extend(c.a1 + s0 * (c.b1 - c.a1)).extend(c.a1 + s1 * (c.b1 - c.a1));
+      b.min().array() -= c.radius_mm + inflate;
+      b.max().array() += c.radius_mm + inflate;
+      f(b);
+    }
+  };
+
+  // Refit: awake patches near a sweep now; other awake patches round-robin (the fat margin covers
+  // their motion in between); sleeping patches have not moved.
+  if (m.refit_stamp.size() != m.patches.size()) m.refit_stamp.assign(m.patches.size(), 0);
+  auto refit_if_awake = [&](std::uint32_t pi) {
+    if (m.refit_stamp[pi] == step) return;
+    m.refit_stamp[pi] = step;
+    Patch& p = m.patches[pi];
     const Surface& s = world.surface(p.surface);
-    if (!patch_awake(s, p)) continue;  // asleep: has not moved
-    bool near = false;
-    for (std::uint32_t k = 0; k < n && !near; ++k) {
-      Box3 b = swept[k];
-      b.min().array() -= options_.near_mm;
-      b.max().array() += options_.near_mm;
-      near = b.intersects(p.fat);
-    }
-    if (near || (step + i) % options_.far_refit_period == 0) {
-      m.refit(s, p, options_.margin_mm);
-      ++stats_.patches_refit;
-    }
+    if (!patch_awake(s, p)) return;
+    m.refit(s, p, options_.margin_mm);
+    ++stats_.patches_refit;
+  };
+  for (std::uint32_t k = 0; k < n; ++k) {
+    for_each_chunk(colliders[k], options_.near_mm, [&](const Box3& b) {
+      m.query_box_hits(b);
+      for (auto pi : m.hits) refit_if_awake(pi);
+    });
+  }
+  for (std::size_t i = step % options_.far_refit_period; i < m.patches.size(); i += options_.far_refit_period) {
+    refit_if_awake(static_cast<std::uint32_t>(i));
   }
 
-  // Tissue moves a little within the step: triangles this close to a sweep are candidates too.
-  constexpr double kSlack_mm = 0.1;
+  // Candidates: triangles of the patches the chunks hit whose bounding sphere comes within reach of
+  // the swept axis.
+  if (m.candidate_stamp.size() != m.patches.size()) m.candidate_stamp.assign(m.patches.size(), 0);
   for (std::uint32_t k = 0; k < n; ++k) {
     const auto& c = colliders[k];
-    m.query_box_hits(swept[k]);
-    stats_.patches_hit += static_cast<std::uint32_t>(m.hits.size());
-    Box3 reach = swept[k];
-    reach.min().array() -= kSlack_mm;
-    reach.max().array() += kSlack_mm;
-    for (auto pi : m.hits) {
-      const Patch& p = m.patches[pi];
-      const Surface& s = world.surface(p.surface);
-      for (auto t : p.triangles) {
-        if (!s.triangle_alive(t)) continue;
-        const auto tv = s.triangle_vertices(t);
-        const Vec3& x0 = s.position(tv[0]);
-        const Vec3& x1 = s.position(tv[1]);
-        const Vec3& x2 = s.position(tv[2]);
-        Box3 tb(x0);
-        tb.extend(x1).extend(x2);
-        if (!tb.intersects(reach)) continue;
-        if (out.size() == out.capacity()) {
-          stats_.candidates_truncated = true;
-          continue;
+    const std::uint64_t stamp = step * TissueWorld::kMaxColliders + k + 1;
+    const Vec3 motion_a = c.a1 - c.a0, motion_b = c.b1 - c.b0;
+    const double motion = std::max(motion_a.norm(), motion_b.norm());
+    for_each_chunk(c, kSlack_mm, [&](const Box3& box) {
+      m.query_box_hits(box);
+      stats_.patches_hit += static_cast<std::uint32_t>(m.hits.size());
+      for (auto pi : m.hits) {
+        if (m.candidate_stamp[pi] == stamp) continue;
+        m.candidate_stamp[pi] = stamp;
+        const Patch& p = m.patches[pi];
+        const Surface& s = world.surface(p.surface);
+        for (auto t : p.triangles) {
+          if (!s.triangle_alive(t)) continue;
+          const auto tv = s.triangle_vertices(t);
+          const Vec3& x0 = s.position(tv[0]);
+          const Vec3& x1 = s.position(tv[1]);
+          const Vec3& x2 = s.position(tv[2]);
+          const Vec3 centroid = (x0 + x1 + x2) / 3.0;
+          const double tri_r = std::sqrt(std::max({(x0 - centroid).squaredNorm(), (x1 - centroid).squaredNorm(), (x2 - centroid).squaredNorm()}));
+          double sp = 0.0, tq = 0.0;
+          const double d2 = contact::closest_segment_segment(c.a1, c.b1, centroid, centroid, sp, tq);
+          const double reach = c.radius_mm + tri_r + kSlack_mm + motion;
+          if (d2 > reach * reach) continue;
+          if (out.size() == out.capacity()) {
+            stats_.candidates_truncated = true;
+            continue;
+          }
+          // The side the instrument is on before the step (only used if it would cross the
+          // triangle); a crossing, which the solver never leaves behind, falls back to the port
+          // end, which is always on the entry side.
+          const Vec3 normal = (x1 - x0).cross(x2 - x0);
+          const auto st = contact::closest_segment_triangle(c.a0, c.b0, x0, x1, x2);
+          const double side = st.crossing || st.distance < 1e-9 ? normal.dot(c.a0 - x0) : normal.dot(st.on_segment - st.on_triangle);
+          out.push_back({k, p.surface, t, static_cast<std::int8_t>(side < 0.0 ? -1 : 1)});
         }
-        // The side the instrument is on before the step; a crossing (which the solver never
-        // leaves behind) falls back to the port end, which is always on the entry side.
-        const Vec3 normal = (x1 - x0).cross(x2 - x0);
-        const auto st = contact::closest_segment_triangle(c.a0, c.b0, x0, x1, x2);
-        const double side = st.crossing || st.distance < 1e-9 ? normal.dot(c.a0 - x0) : normal.dot(st.on_segment - st.on_triangle);
-        out.push_back({k, p.surface, t, static_cast<std::int8_t>(side < 0.0 ? -1 : 1)});
       }
-    }
+    });
   }
   stats_.candidates = static_cast<std::uint32_t>(out.size());
 }
