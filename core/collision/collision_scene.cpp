@@ -24,7 +24,8 @@ using Box3 = Eigen::AlignedBox3d;
 struct Patch {
   std::uint32_t surface = 0;
   std::vector<std::uint32_t> triangles;
-  std::vector<std::uint32_t> blocks;  // vertex sleep blocks its triangles use
+  std::vector<std::uint32_t> blocks;    // vertex sleep blocks its triangles use
+  std::vector<std::uint32_t> vertices;  // its triangles' vertices, each once (for refits)
   Box3 fat;
   std::shared_ptr<fcl::Boxd> box;
   std::unique_ptr<fcl::CollisionObjectd> object;
@@ -40,11 +41,19 @@ bool patch_awake(const Surface& s, const Patch& p) {
 Box3 tight_box(const Surface& s, const Patch& p) {
   Box3 box;
   box.setEmpty();
-  for (auto t : p.triangles) {
-    if (!s.triangle_alive(t)) continue;
-    for (auto v : s.triangle_vertices(t)) box.extend(s.position(v));
+  for (auto v : p.vertices) {
+    if (s.vertex_alive(v)) box.extend(s.position(v));
   }
   return box;
+}
+
+void collect_vertices(const Surface& s, Patch& p) {
+  p.vertices.clear();
+  for (auto t : p.triangles) {
+    for (auto v : s.triangle_vertices(t)) p.vertices.push_back(v);
+  }
+  std::sort(p.vertices.begin(), p.vertices.end());
+  p.vertices.erase(std::unique(p.vertices.begin(), p.vertices.end()), p.vertices.end());
 }
 
 Eigen::Matrix3d rotation_from_z(const Vec3& d) {
@@ -70,59 +79,125 @@ bool collect_patch(fcl::CollisionObjectd* patch, fcl::CollisionObjectd* /*query*
 }  // namespace
 
 struct CollisionScene::Impl {
+  // Per surface: which patch each triangle slot belongs to, so a topology change (a tear, a cut)
+  // only moves the triangles whose slots changed instead of rebuilding everything.
+  struct SurfaceIndex {
+    std::uint64_t version = ~std::uint64_t{0};
+    std::unordered_map<std::int64_t, std::uint32_t> cell_to_patch;
+    std::vector<std::uint32_t> tri_patch;       // per slot, kNone when not assigned
+    std::vector<std::uint32_t> tri_generation;  // generation of the slot when assigned
+  };
   std::vector<Patch> patches;
-  std::vector<std::uint64_t> surface_versions;
+  std::vector<SurfaceIndex> surfaces;
   std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager;
   std::shared_ptr<fcl::Boxd> query_box;
   std::unique_ptr<fcl::CollisionObjectd> query;
   std::vector<std::uint32_t> hits;
   std::vector<std::uint64_t> refit_stamp, candidate_stamp;
+  std::vector<fcl::CollisionObjectd*> changed;
+  std::vector<std::uint32_t> dirty;  // patches whose triangle set changed
+  std::vector<std::uint8_t> is_dirty;
   std::uint64_t steps = 0;
+  double cell_mm = 1.5;
+  double margin_mm = 0.4;
 
-  void build(const TissueWorld& world, const CollisionOptions& o) {
-    patches.clear();
-    surface_versions.clear();
-    manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
-    for (std::uint32_t si = 0; si < world.surface_count(); ++si) {
-      const Surface& s = world.surface(si);
-      surface_versions.push_back(s.topology_version());
-      std::unordered_map<std::int64_t, std::uint32_t> cell_to_patch;
-      for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
-        if (!s.triangle_alive(t)) continue;
-        const auto tv = s.triangle_vertices(t);
-        const Vec3 c = (s.rest_position(tv[0]) + s.rest_position(tv[1]) + s.rest_position(tv[2])) / 3.0;
-        auto cell = [&](double x) { return static_cast<std::int64_t>(std::floor(x / o.patch_cell_mm)) & 0x1FFFFF; };
-        const std::int64_t key = (cell(c.x()) << 42) | (cell(c.y()) << 21) | cell(c.z());
-        auto [it, inserted] = cell_to_patch.try_emplace(key, static_cast<std::uint32_t>(patches.size()));
-        if (inserted) {
-          patches.emplace_back();
-          patches.back().surface = si;
-        }
-        Patch& p = patches[it->second];
-        p.triangles.push_back(t);
-        for (auto v : tv) {
-          const std::uint32_t b = v / Surface::kSleepBlock;
-          if (std::find(p.blocks.begin(), p.blocks.end(), b) == p.blocks.end()) p.blocks.push_back(b);
-        }
-      }
-    }
-    std::vector<fcl::CollisionObjectd*> objects;
-    for (std::size_t i = 0; i < patches.size(); ++i) {
-      Patch& p = patches[i];
-      p.fat = tight_box(world.surface(p.surface), p);
-      p.fat.min().array() -= o.margin_mm;
-      p.fat.max().array() += o.margin_mm;
-      p.box = std::make_shared<fcl::Boxd>(p.fat.sizes());
+  std::uint32_t patch_for(std::uint32_t si, const Surface& s, std::uint32_t t) {
+    const auto tv = s.triangle_vertices(t);
+    const Vec3 c = (s.rest_position(tv[0]) + s.rest_position(tv[1]) + s.rest_position(tv[2])) / 3.0;
+    auto cell = [&](double x) { return static_cast<std::int64_t>(std::floor(x / cell_mm)) & 0x1FFFFF; };
+    const std::int64_t key = (cell(c.x()) << 42) | (cell(c.y()) << 21) | cell(c.z());
+    auto [it, inserted] = surfaces[si].cell_to_patch.try_emplace(key, static_cast<std::uint32_t>(patches.size()));
+    if (inserted) {
+      patches.emplace_back();
+      Patch& p = patches.back();
+      p.surface = si;
+      p.fat.setEmpty();
+      p.box = std::make_shared<fcl::Boxd>(1.0, 1.0, 1.0);
       p.object = std::make_unique<fcl::CollisionObjectd>(p.box);
+      p.object->setUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(patches.size() - 1)));
+      is_dirty.push_back(0);
+      refit_stamp.push_back(0);
+      candidate_stamp.push_back(0);
+    }
+    return it->second;
+  }
+
+  void mark_dirty(std::uint32_t pi) {
+    if (!is_dirty[pi]) {
+      is_dirty[pi] = 1;
+      dirty.push_back(pi);
+    }
+  }
+
+  // Brings the patches of surface si up to date with its triangle slots.
+  void sync(std::uint32_t si, const Surface& s) {
+    SurfaceIndex& ix = surfaces[si];
+    if (ix.version == s.topology_version()) return;
+    ix.version = s.topology_version();
+    if (ix.tri_patch.size() < s.triangle_slots()) {
+      ix.tri_patch.resize(s.triangle_slots(), kNone);
+      ix.tri_generation.resize(s.triangle_slots(), 0);
+    }
+    for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+      const bool alive = s.triangle_alive(t);
+      const std::uint32_t old = ix.tri_patch[t];
+      if (alive && old != kNone && ix.tri_generation[t] == s.triangle_id(t).generation) continue;
+      if (!alive && old == kNone) continue;
+      if (old != kNone) {  // freed or reused slot: out of its old patch
+        auto& list = patches[old].triangles;
+        list.erase(std::find(list.begin(), list.end(), t));
+        ix.tri_patch[t] = kNone;
+        mark_dirty(old);
+      }
+      if (!alive) continue;
+      const std::uint32_t pi = patch_for(si, s, t);
+      Patch& p = patches[pi];
+      p.triangles.push_back(t);
+      for (auto v : s.triangle_vertices(t)) {
+        const std::uint32_t b = v / Surface::kSleepBlock;
+        if (std::find(p.blocks.begin(), p.blocks.end(), b) == p.blocks.end()) p.blocks.push_back(b);
+      }
+      ix.tri_patch[t] = pi;
+      ix.tri_generation[t] = s.triangle_id(t).generation;
+      mark_dirty(pi);
+    }
+  }
+
+  // Refits the patches whose triangle sets changed; new patches join the broad phase.
+  void refit_dirty(const TissueWorld& world) {
+    for (auto pi : dirty) {
+      is_dirty[pi] = 0;
+      Patch& p = patches[pi];
+      collect_vertices(world.surface(p.surface), p);
+      const bool registered = !p.fat.isEmpty();
+      Box3 tight = tight_box(world.surface(p.surface), p);
+      if (tight.isEmpty()) tight = registered ? p.fat : Box3(Vec3::Zero(), Vec3::Zero());
+      p.fat = tight;
+      p.fat.min().array() -= margin_mm;
+      p.fat.max().array() += margin_mm;
+      p.box->side = p.fat.sizes();
+      p.box->computeLocalAABB();
       p.object->setTranslation(p.fat.center());
       p.object->computeAABB();
-      p.object->setUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)));
-      objects.push_back(p.object.get());
+      if (registered) {
+        changed.push_back(p.object.get());
+      } else {
+        manager->registerObject(p.object.get());
+      }
     }
-    manager->registerObjects(objects);
+    dirty.clear();
+  }
+
+  void build(const TissueWorld& world, const CollisionOptions& o) {
+    cell_mm = o.patch_cell_mm;
+    margin_mm = o.margin_mm;
+    manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+    surfaces.assign(world.surface_count(), {});
+    for (std::uint32_t si = 0; si < world.surface_count(); ++si) sync(si, world.surface(si));
+    refit_dirty(world);
     manager->setup();
-    hits.clear();
-    hits.reserve(patches.size());
+    hits.reserve(2 * patches.size() + 1024);
+    changed.reserve(2 * patches.size() + 1024);
   }
 
   void refit(const Surface& s, Patch& p, double margin) {
@@ -135,7 +210,14 @@ struct CollisionScene::Impl {
     p.box->computeLocalAABB();
     p.object->setTranslation(p.fat.center());
     p.object->computeAABB();
-    manager->update(p.object.get());
+    changed.push_back(p.object.get());
+  }
+
+  // One tree update for all refit patches: FCL's single-object update rebalances the tree each call.
+  void commit() {
+    if (changed.empty()) return;
+    manager->update(changed);
+    changed.clear();
   }
 
   // Patches whose fat box overlaps `box` (FCL broad phase).
@@ -167,11 +249,14 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
   Impl& m = *impl_;
   out.clear();
   stats_ = {};
-  bool rebuild = world.surface_count() != m.surface_versions.size();
-  for (std::uint32_t si = 0; si < world.surface_count() && !rebuild; ++si) {
-    rebuild = world.surface(si).topology_version() != m.surface_versions[si];
+  if (world.surface_count() != m.surfaces.size()) {
+    m.build(world, options_);  // a surface was added: start over (allocates)
+  } else {
+    // Tears and cuts since the last step: move only the triangles whose slots changed.
+    for (std::uint32_t si = 0; si < world.surface_count(); ++si) m.sync(si, world.surface(si));
+    m.refit_dirty(world);
+    m.commit();
   }
-  if (rebuild) m.build(world, options_);
   stats_.patches = static_cast<std::uint32_t>(m.patches.size());
   const std::uint64_t step = ++m.steps;
 
@@ -195,7 +280,6 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
 
   // Refit: awake patches near a sweep now; other awake patches round-robin (the fat margin covers
   // their motion in between); sleeping patches have not moved.
-  if (m.refit_stamp.size() != m.patches.size()) m.refit_stamp.assign(m.patches.size(), 0);
   auto refit_if_awake = [&](std::uint32_t pi) {
     if (m.refit_stamp[pi] == step) return;
     m.refit_stamp[pi] = step;
@@ -214,10 +298,10 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
   for (std::size_t i = step % options_.far_refit_period; i < m.patches.size(); i += options_.far_refit_period) {
     refit_if_awake(static_cast<std::uint32_t>(i));
   }
+  m.commit();
 
   // Candidates: triangles of the patches the chunks hit whose bounding sphere comes within reach of
   // the swept axis.
-  if (m.candidate_stamp.size() != m.patches.size()) m.candidate_stamp.assign(m.patches.size(), 0);
   for (std::uint32_t k = 0; k < n; ++k) {
     const auto& c = colliders[k];
     const std::uint64_t stamp = step * TissueWorld::kMaxColliders + k + 1;

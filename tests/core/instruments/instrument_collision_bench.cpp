@@ -46,12 +46,20 @@ RetinaCapOptions scene_options() {
 constexpr int kWarmup = 300;
 constexpr int kSteps = 3000;
 
-// Tip paths: circles over the posterior pole, dipping into the membrane and the retina.
+// Tip paths. Instrument 0 works in the bullous detachment (centre 60° from the posterior pole on
+// the −x side), pushing the free retina in and out; instrument 1 sweeps over the posterior pole just
+// above the membrane, brushing it.
 Vec3 path(int instrument, int step) {
   const double t = step * 1e-3;
-  const double phase = instrument * std::numbers::pi;
-  const double a = 2.0 * std::numbers::pi * 0.5 * t + phase;
-  return {2.5 * std::cos(a), 2.5 * std::sin(a), -11.3 + 0.5 * std::sin(2.0 * std::numbers::pi * 1.3 * t + phase)};
+  const double a = 2.0 * std::numbers::pi * 0.5 * t;
+  if (instrument == 0) {
+    const double th = 60.0 * std::numbers::pi / 180.0;
+    const Vec3 radial(-std::sin(th), 0.0, -std::cos(th));
+    const Vec3 side = Vec3::UnitY();
+    const Vec3 along = radial.cross(side);
+    return radial * (9.5 + 1.0 * std::sin(2.0 * std::numbers::pi * 0.7 * t)) + 1.5 * (std::cos(a) * side + std::sin(a) * along);
+  }
+  return {2.0 * std::cos(a), 2.0 * std::sin(a), -11.25 + 0.15 * std::sin(2.0 * std::numbers::pi * 1.3 * t)};
 }
 
 void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
