@@ -578,3 +578,59 @@ TEST(Instruments, ExcessiveForceOnTheRetinaIsReported) {
   EXPECT_GE(events, 1u);
   EXPECT_GT(peak, o.retina_force_limit_un);
 }
+
+TEST(Instruments, PickLiftsOneEdgeWithoutTakingTheOther) {
+  // Two flaps either side of a cut (a 0.8 mm gap along x = 0), anchored at their far ends.
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  auto flap = [&](double x0) {
+    SurfaceDescription d;
+    d.mesh = test::rectangle(2.6, 3.0, 26, 30);
+    for (auto& p : d.mesh.positions) p += Vec3(x0, -1.5, 0.0);
+    d.material.tear_strain = INFINITY;
+    d.contained_by_globe = false;
+    const std::uint32_t s = world.add_surface(d);
+    Surface& surf = world.surface(s);
+    for (std::uint32_t v = 0; v < surf.vertex_slots(); ++v) {
+      if (std::abs(std::abs(surf.rest_position(v).x()) - 3.0) < 1e-9) {
+        EXPECT_TRUE(surf.set_fixed(surf.vertex_id(v), true));
+      }
+    }
+    return s;
+  };
+  const std::uint32_t left = flap(-3.0), right = flap(0.4);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0.1, 0, 10)};
+  InstrumentDescription pick{InstrumentKind::kPick, Gauge::k25, 0, {}};
+  pick.dimensions.pick_length_mm = 0.6;
+  InstrumentSystem sys(world, o, {pick});
+  auto at = [&](double z, double twist = 0.0) {
+    return InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z, twist);
+  };
+  // Down through the gap with the hook along it, turned under the right flap (+x), then up by 1 mm
+  // at 10 mm/s.
+  const double along = std::numbers::pi / 2;
+  for (int i = 0; i <= 100; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(1.0 - 1.2 * i / 100.0, along)));
+    sys.step(kDt);
+  }
+  for (int i = 0; i <= 100; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-0.2, along * (1.0 - i / 100.0))));
+    sys.step(kDt);
+  }
+  ASSERT_GT(sys.instrument(0).frame.v.x(), 0.99);
+  for (int i = 1; i <= 100; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-0.2 + 1.0 * i / 100.0)));
+    sys.step(kDt);
+  }
+  const Surface& l = world.surface(left);
+  const Surface& r = world.surface(right);
+  double left_max = -1e9, right_edge = -1e9;
+  for (std::uint32_t v = 0; v < l.vertex_slots(); ++v) left_max = std::max(left_max, l.position(v).z());
+  for (std::uint32_t v = 0; v < r.vertex_slots(); ++v) {
+    if (std::abs(r.rest_position(v).y()) < 0.3 && r.rest_position(v).x() < 0.75) right_edge = std::max(right_edge, r.position(v).z());
+  }
+  EXPECT_GT(right_edge, 0.5);   // the hooked edge came up with the pick
+  EXPECT_LT(left_max, 0.05);    // the other edge was not taken along
+  EXPECT_EQ(sys.instrument(0).grip, kNone);
+  for (std::uint32_t g = 0; g < 4; ++g) EXPECT_FALSE(world.grip_active(g));  // a pick never grabs
+}
