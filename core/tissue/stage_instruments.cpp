@@ -46,7 +46,7 @@ Status TissueWorld::set_contact_candidates(std::span<const ContactCandidate> can
   candidates_.clear();
   for (const auto& c : candidates) {
     if (candidates_.size() == candidates_.capacity()) return Status::error("set_contact_candidates: capacity exceeded");
-    if (c.collider >= kMaxColliders || c.surface >= surfaces_.size() || c.surface >= kMaxContactSurfaces ||
+    if (c.collider >= kMaxColliders || c.surface >= surfaces_.size() ||
         !surfaces_[c.surface]->triangle_alive(c.triangle)) {
       continue;  // stale after a topology change: dropped
     }
@@ -71,13 +71,13 @@ Status TissueWorld::set_suction_fields(std::span<const SuctionField> fields) {
 }
 
 Vec3 TissueWorld::contact_force(std::uint32_t collider, std::uint32_t surface) const {
-  if (collider >= kMaxColliders || surface >= kMaxContactSurfaces) return Vec3::Zero();
-  return contact_force_[collider * kMaxContactSurfaces + surface];
+  if (collider >= kMaxColliders || surface >= surfaces_.size()) return Vec3::Zero();
+  return contact_force_[collider * surfaces_.size() + surface];
 }
 
 Vec3 TissueWorld::contact_force(std::uint32_t collider) const {
   Vec3 f = Vec3::Zero();
-  for (std::uint32_t s = 0; s < kMaxContactSurfaces; ++s) f += contact_force(collider, s);
+  for (std::uint32_t s = 0; s < surfaces_.size(); ++s) f += contact_force(collider, s);
   return f;
 }
 
@@ -207,7 +207,7 @@ void TissueWorld::project_contacts(double h, double fraction) {
     x0 += (w[tv[0]] * bc[0] * lambda) * n;
     x1 += (w[tv[1]] * bc[1] * lambda) * n;
     x2 += (w[tv[2]] * bc[2] * lambda) * n;
-    contact_force_[c.collider * kMaxContactSurfaces + c.surface] -= n * (lambda * inv_h2 * share);
+    contact_force_[c.collider * surfaces_.size() + c.surface] -= n * (lambda * inv_h2 * share);
   }
 }
 

@@ -44,7 +44,6 @@ TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings
   colliders_.resize(kMaxColliders);
   candidates_.reserve(kMaxContactCandidates);
   suction_.reserve(kMaxSuctionFields);
-  contact_force_.assign(std::size_t{kMaxColliders} * kMaxContactSurfaces, Vec3::Zero());
   contact_depth_.assign(kMaxColliders, 0.0);
   grips_.resize(kMaxGrips);
 }
@@ -76,6 +75,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.lambda_direction.resize(surface->edge_capacity());
   surfaces_.push_back(std::move(surface));
   scratch_.push_back(std::move(s));
+  contact_force_.assign(std::size_t{kMaxColliders} * surfaces_.size(), Vec3::Zero());
   return static_cast<std::uint32_t>(surfaces_.size() - 1);
 }
 

@@ -177,7 +177,6 @@ class TissueWorld {
   static constexpr std::uint32_t kMaxContactCandidates = 32768;
   static constexpr std::uint32_t kMaxGrips = 4096;
   static constexpr std::uint32_t kMaxSuctionFields = 4;
-  static constexpr std::uint32_t kMaxContactSurfaces = 16;
   // Colliders and candidates for the next step (copied; extra entries beyond capacity are refused).
   Status set_colliders(std::span<const ColliderCapsule> colliders);
   Status set_contact_candidates(std::span<const ContactCandidate> candidates);
@@ -324,7 +323,7 @@ class TissueWorld {
   std::uint32_t collider_count_ = 0;
   std::vector<ContactCandidate> candidates_;
   std::vector<SuctionField> suction_;
-  std::vector<Vec3> contact_force_;     // kMaxColliders × kMaxContactSurfaces, accumulated
+  std::vector<Vec3> contact_force_;     // kMaxColliders × surfaces, accumulated over a step
   std::vector<double> contact_depth_;   // kMaxColliders
   std::vector<Grip> grips_;
   std::uint32_t grip_high_water_ = 0;

@@ -36,9 +36,9 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<std::size_t>(std::min<double>(v.size() - 1, std::floor(p * static_cast<double>(v.size()))))];
 }
 
-RetinaCapOptions scene_options() {
+RetinaCapOptions scene_options(int vertices) {
   RetinaCapOptions o;
-  o.retina_vertices = 10000;  // ~20k triangles
+  o.retina_vertices = vertices;  // 10000 vertices: ~20k triangles
   o.membrane = true;
   return o;
 }
@@ -64,7 +64,7 @@ Vec3 path(int instrument, int step) {
 
 void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
   for (auto _ : state) {
-    RetinaCapScene scene = build_retina_cap(scene_options());
+    RetinaCapScene scene = build_retina_cap(scene_options(static_cast<int>(state.range(0))));
     std::uint32_t tris = 0;
     for (std::uint32_t s = 0; s < scene.world.surface_count(); ++s) tris += scene.world.surface(s).triangle_count();
     InstrumentSceneOptions o;
@@ -90,7 +90,7 @@ void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
       refits.push_back(r.patches_refit);
     }
     // Reference: the same scene without instruments.
-    RetinaCapScene ref = build_retina_cap(scene_options());
+    RetinaCapScene ref = build_retina_cap(scene_options(static_cast<int>(state.range(0))));
     std::vector<double> reference;
     for (int i = 0; i < kWarmup + kSteps; ++i) {
       const auto t0 = Clock::now();
@@ -114,4 +114,4 @@ void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_TwoInstrumentsVsRetinaAndMembrane)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TwoInstrumentsVsRetinaAndMembrane)->Arg(10000)->Arg(20000)->Iterations(1)->Unit(benchmark::kMillisecond);
