@@ -93,6 +93,7 @@ struct CollisionScene::Impl {
   std::shared_ptr<fcl::Boxd> query_box;
   std::unique_ptr<fcl::CollisionObjectd> query;
   std::vector<std::uint32_t> hits;
+  std::vector<std::uint32_t> collider_hits;  // patches per collider this step (flat)
   std::vector<std::uint64_t> refit_stamp, candidate_stamp;
   std::vector<fcl::CollisionObjectd*> changed;
   std::vector<std::uint32_t> dirty;  // patches whose triangle set changed
@@ -197,6 +198,7 @@ struct CollisionScene::Impl {
     refit_dirty(world);
     manager->setup();
     hits.reserve(2 * patches.size() + 1024);
+    collider_hits.reserve(8 * patches.size() + 4096);
     changed.reserve(2 * patches.size() + 1024);
   }
 
@@ -289,58 +291,66 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
     m.refit(s, p, options_.margin_mm);
     ++stats_.patches_refit;
   };
+  // One broad-phase query per chunk: the patches it returns are refit (if awake) and later scanned
+  // for candidates. Their fat boxes contain their triangles, so a patch missed by the inflated chunk
+  // box has no triangle within reach of it.
+  m.collider_hits.clear();
+  std::array<std::uint32_t, TissueWorld::kMaxColliders + 1> begin{};
+  const double inflate = std::max(options_.near_mm, kSlack_mm);
   for (std::uint32_t k = 0; k < n; ++k) {
-    for_each_chunk(colliders[k], options_.near_mm, [&](const Box3& b) {
+    begin[k] = static_cast<std::uint32_t>(m.collider_hits.size());
+    const std::uint64_t stamp = step * TissueWorld::kMaxColliders + k + 1;
+    for_each_chunk(colliders[k], inflate, [&](const Box3& b) {
       m.query_box_hits(b);
-      for (auto pi : m.hits) refit_if_awake(pi);
+      stats_.patches_hit += static_cast<std::uint32_t>(m.hits.size());
+      for (auto pi : m.hits) {
+        if (m.candidate_stamp[pi] == stamp) continue;
+        m.candidate_stamp[pi] = stamp;
+        refit_if_awake(pi);
+        if (m.collider_hits.size() < m.collider_hits.capacity()) m.collider_hits.push_back(pi);
+      }
     });
   }
+  begin[n] = static_cast<std::uint32_t>(m.collider_hits.size());
   for (std::size_t i = step % options_.far_refit_period; i < m.patches.size(); i += options_.far_refit_period) {
     refit_if_awake(static_cast<std::uint32_t>(i));
   }
   m.commit();
 
-  // Candidates: triangles of the patches the chunks hit whose bounding sphere comes within reach of
-  // the swept axis.
+  // Candidates: triangles of those patches whose bounding sphere comes within reach of the swept
+  // axis.
   for (std::uint32_t k = 0; k < n; ++k) {
     const auto& c = colliders[k];
-    const std::uint64_t stamp = step * TissueWorld::kMaxColliders + k + 1;
     const Vec3 motion_a = c.a1 - c.a0, motion_b = c.b1 - c.b0;
     const double motion = std::max(motion_a.norm(), motion_b.norm());
-    for_each_chunk(c, kSlack_mm, [&](const Box3& box) {
-      m.query_box_hits(box);
-      stats_.patches_hit += static_cast<std::uint32_t>(m.hits.size());
-      for (auto pi : m.hits) {
-        if (m.candidate_stamp[pi] == stamp) continue;
-        m.candidate_stamp[pi] = stamp;
-        const Patch& p = m.patches[pi];
-        const Surface& s = world.surface(p.surface);
-        for (auto t : p.triangles) {
-          if (!s.triangle_alive(t)) continue;
-          const auto tv = s.triangle_vertices(t);
-          const Vec3& x0 = s.position(tv[0]);
-          const Vec3& x1 = s.position(tv[1]);
-          const Vec3& x2 = s.position(tv[2]);
-          const Vec3 centroid = (x0 + x1 + x2) / 3.0;
-          const double tri_r = std::sqrt(std::max({(x0 - centroid).squaredNorm(), (x1 - centroid).squaredNorm(), (x2 - centroid).squaredNorm()}));
-          double sp = 0.0, tq = 0.0;
-          const double d2 = contact::closest_segment_segment(c.a1, c.b1, centroid, centroid, sp, tq);
-          const double reach = c.radius_mm + tri_r + kSlack_mm + motion;
-          if (d2 > reach * reach) continue;
-          if (out.size() == out.capacity()) {
-            stats_.candidates_truncated = true;
-            continue;
-          }
-          // The side the instrument is on before the step (only used if it would cross the
-          // triangle); a crossing, which the solver never leaves behind, falls back to the port
-          // end, which is always on the entry side.
-          const Vec3 normal = (x1 - x0).cross(x2 - x0);
-          const auto st = contact::closest_segment_triangle(c.a0, c.b0, x0, x1, x2);
-          const double side = st.crossing || st.distance < 1e-9 ? normal.dot(c.a0 - x0) : normal.dot(st.on_segment - st.on_triangle);
-          out.push_back({k, p.surface, t, static_cast<std::int8_t>(side < 0.0 ? -1 : 1)});
+    for (std::uint32_t h = begin[k]; h < begin[k + 1]; ++h) {
+      const Patch& p = m.patches[m.collider_hits[h]];
+      const Surface& s = world.surface(p.surface);
+      for (auto t : p.triangles) {
+        if (!s.triangle_alive(t)) continue;
+        const auto tv = s.triangle_vertices(t);
+        const Vec3& x0 = s.position(tv[0]);
+        const Vec3& x1 = s.position(tv[1]);
+        const Vec3& x2 = s.position(tv[2]);
+        const Vec3 centroid = (x0 + x1 + x2) / 3.0;
+        const double tri_r = std::sqrt(std::max({(x0 - centroid).squaredNorm(), (x1 - centroid).squaredNorm(), (x2 - centroid).squaredNorm()}));
+        double sp = 0.0, tq = 0.0;
+        const double d2 = contact::closest_segment_segment(c.a1, c.b1, centroid, centroid, sp, tq);
+        const double reach = c.radius_mm + tri_r + kSlack_mm + motion;
+        if (d2 > reach * reach) continue;
+        if (out.size() == out.capacity()) {
+          stats_.candidates_truncated = true;
+          continue;
         }
+        // The side the instrument is on before the step (only used if it would cross the
+        // triangle); a crossing, which the solver never leaves behind, falls back to the port
+        // end, which is always on the entry side.
+        const Vec3 normal = (x1 - x0).cross(x2 - x0);
+        const auto st = contact::closest_segment_triangle(c.a0, c.b0, x0, x1, x2);
+        const double side = st.crossing || st.distance < 1e-9 ? normal.dot(c.a0 - x0) : normal.dot(st.on_segment - st.on_triangle);
+        out.push_back({k, p.surface, t, static_cast<std::int8_t>(side < 0.0 ? -1 : 1)});
       }
-    });
+    }
   }
   stats_.candidates = static_cast<std::uint32_t>(out.size());
 }
