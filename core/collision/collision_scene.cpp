@@ -325,6 +325,13 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
     const double motion = std::max(motion_a.norm(), motion_b.norm());
     for (std::uint32_t h = begin[k]; h < begin[k + 1]; ++h) {
       const Patch& p = m.patches[m.collider_hits[h]];
+      {  // the patch's bounding sphere first
+        double sp = 0.0, tq = 0.0;
+        const Vec3 center = p.fat.center();
+        const double d2 = contact::closest_segment_segment(c.a1, c.b1, center, center, sp, tq);
+        const double reach = c.radius_mm + 0.5 * p.fat.diagonal().norm() + kSlack_mm + motion;
+        if (d2 > reach * reach) continue;
+      }
       const Surface& s = world.surface(p.surface);
       for (auto t : p.triangles) {
         if (!s.triangle_alive(t)) continue;

@@ -74,6 +74,7 @@ void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
     Probe pr;
     sys.set_phase_probe(probe, &pr);
     std::vector<double> collision, tissue, candidates, refits;
+    double tears = 0.0, tear_steps = 0.0;
     for (int i = 0; i < kWarmup + kSteps; ++i) {
       for (std::uint32_t k = 0; k < 2; ++k) {
         const Vec3 tip = path(static_cast<int>(k), i);
@@ -84,6 +85,8 @@ void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
       }
       const auto r = sys.step(1e-3);
       if (i < kWarmup) continue;
+      tears += r.tissue.tears;
+      tear_steps += r.tissue.tears > 0 ? 1.0 : 0.0;
       collision.push_back(us(pr.t[0], pr.t[1]));
       tissue.push_back(us(pr.t[1], pr.t[2]));
       candidates.push_back(r.candidates);
@@ -98,6 +101,8 @@ void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
       if (i >= kWarmup) reference.push_back(us(t0, Clock::now()));
     }
     state.counters["triangles"] = tris;
+    state.counters["tears"] = tears;
+    state.counters["steps_with_tears"] = tear_steps;
     state.counters["patches"] = sys.collision_stats().patches;
     state.counters["collision_p50_us"] = percentile(collision, 0.5);
     state.counters["collision_p99_us"] = percentile(collision, 0.99);
