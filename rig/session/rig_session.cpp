@@ -91,6 +91,12 @@ SessionSummary run_session(const SessionConfig& config) {
       if (cmd.code == telemetry::CommandCode::Pause) model.set_paused(true);
       if (cmd.code == telemetry::CommandCode::Resume) model.set_paused(false);
     }
+    // What the command server validates the next commands against (one case for now).
+    telemetry::CommandContext& context = commands.context().write_slot();
+    context.paused = model.paused();
+    context.case_index = 0;
+    context.case_count = 1;
+    commands.context().publish();
     auto consume = [&](const telemetry::DeviceInput& in) {
       telemetry::DeviceInput stamped = in;
       stamped.step = step;
