@@ -1,0 +1,109 @@
+#include "vitreo/render/render_thread.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <future>
+
+#include "vitreo/render/frame_ring.hpp"
+#include "vitreo/render/png_io.hpp"
+
+namespace vitreo::render {
+
+RenderThread::RenderThread(RenderThreadOptions options) : options_(std::move(options)) {
+  std::promise<void> started;
+  std::future<void> ready = started.get_future();
+  thread_ = std::thread([this, &started] { run(started); });
+  try {
+    ready.get();  // rethrows the start-up failure
+  } catch (...) {
+    thread_.join();
+    throw;
+  }
+}
+
+RenderThread::~RenderThread() { stop(); }
+
+void RenderThread::publish(FrameScene scene) {
+  mailbox_.publish(std::move(scene));
+  // Wakes the render thread if it sleeps on wake_; a notify is a syscall at most, never a wait.
+  wake_.fetch_add(1, std::memory_order_release);
+  wake_.notify_one();
+}
+
+void RenderThread::request_png(std::string path_prefix) {
+  std::lock_guard lock(mutex_);
+  png_prefix_ = std::move(path_prefix);
+}
+
+void RenderThread::stop() {
+  if (!thread_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  wake_.fetch_add(1, std::memory_order_release);
+  wake_.notify_one();
+  thread_.join();
+}
+
+std::optional<std::string> RenderThread::error() const {
+  std::lock_guard lock(mutex_);
+  return error_;
+}
+
+void RenderThread::run(std::promise<void>& started) {
+  std::unique_ptr<EglContext> context;
+  std::unique_ptr<StereoRenderer> renderer;
+  std::unique_ptr<FrameRingWriter> ring;
+  try {
+    context = std::make_unique<EglContext>(options_.egl);
+    renderer = std::make_unique<StereoRenderer>(options_.render);
+    if (!options_.shm_ring_name.empty())
+      ring = std::make_unique<FrameRingWriter>(options_.shm_ring_name, options_.render.eye_width,
+                                               options_.render.eye_height, options_.shm_ring_slots);
+    context_description_ = context->description();
+    started.set_value();
+  } catch (...) {
+    renderer.reset();
+    context.reset();
+    started.set_exception(std::current_exception());
+    return;
+  }
+  spdlog::info("render thread: {}", context_description_);
+
+  StereoFrame frame;
+  try {
+    for (;;) {
+      const std::uint64_t wake = wake_.load(std::memory_order_acquire);
+      const bool stopping = stop_.load(std::memory_order_acquire);
+      const FrameScene* scene = mailbox_.take();
+      if (scene == nullptr) {
+        if (stopping) break;
+        wake_.wait(wake, std::memory_order_acquire);  // sleeps until the next publish()/stop()
+        continue;
+      }
+      renderer->render(*scene, frame);
+      if (ring) ring->write(frame);
+      std::string prefix;
+      {
+        std::lock_guard lock(mutex_);
+        prefix.swap(png_prefix_);
+      }
+      if (!prefix.empty()) {
+        write_png(prefix + "_left.png", frame.eye(0));
+        write_png(prefix + "_right.png", frame.eye(1));
+        write_png(prefix + "_stereo.png", frame.side_by_side());
+      }
+      if (options_.on_frame) options_.on_frame(frame);
+      last_step_.store(frame.step_index, std::memory_order_release);
+      frames_.fetch_add(1, std::memory_order_acq_rel);
+      frames_.notify_all();
+    }
+  } catch (const std::exception& e) {
+    spdlog::error("render thread stopped: {}", e.what());
+    std::lock_guard lock(mutex_);
+    error_ = e.what();
+  }
+  ring.reset();
+  renderer.reset();
+  context.reset();
+}
+
+}  // namespace vitreo::render
