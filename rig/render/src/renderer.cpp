@@ -21,7 +21,7 @@ Appearance default_appearance(MaterialKind kind, bool detached) {
     case MaterialKind::Retina:
       // Attached retina is nearly transparent (the choroid shows through); detached retina turns
       // greyish-white and translucent (oedema), as surgeons see a bullous detachment.
-      return detached ? Appearance{{0.78f, 0.76f, 0.74f}, 0.55f, 0.35f, 40.0f, true}
+      return detached ? Appearance{{0.82f, 0.80f, 0.78f}, 0.78f, 0.35f, 40.0f, true}
                       : Appearance{{0.95f, 0.80f, 0.70f}, 0.10f, 0.25f, 40.0f, false};
     case MaterialKind::Choroid: return {{0.80f, 0.32f, 0.16f}, 1.0f, 0.10f, 20.0f, false};
     case MaterialKind::Static: return {{0.92f, 0.90f, 0.86f}, 1.0f, 0.15f, 20.0f, false};
@@ -278,6 +278,8 @@ struct StereoRenderer::Impl {
       glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, normal)));
       glEnableVertexAttribArray(2);
       glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
+      glEnableVertexAttribArray(3);
+      glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, detachment)));
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ibo);
       glBindVertexArray(0);
     }
@@ -650,6 +652,12 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     set(p, "u_specular", d.look.specular);
     set(p, "u_shininess", d.look.shininess);
     set(p, "u_detached", d.mesh ? d.mesh->detached : false);
+    if (d.mesh && d.mesh->material == MaterialKind::Retina) {
+      const Appearance det = default_appearance(MaterialKind::Retina, true);
+      const Vec3 t = d.mesh->tint;
+      set(p, "u_detached_colour", Vec3{det.base_colour.x * t.x, det.base_colour.y * t.y, det.base_colour.z * t.z});
+      set(p, "u_detached_opacity", d.mesh->detached ? d.look.opacity : det.opacity);
+    }
     const bool has_tex = d.mesh && d.mesh->texture;
     set(p, "u_has_texture", has_tex);
     if (has_tex) {

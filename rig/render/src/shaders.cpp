@@ -9,6 +9,7 @@ const char* const kSceneVertex = R"(#version 450 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
+layout(location = 3) in float a_detachment;
 uniform mat4 u_model;
 uniform mat4 u_view_projection;
 uniform mat4 u_light_view_projection;
@@ -16,7 +17,9 @@ out vec3 v_position;
 out vec3 v_normal;
 out vec2 v_uv;
 out vec4 v_light_clip;
+out float v_detachment;
 void main() {
+  v_detachment = a_detachment;
   vec4 world = u_model * vec4(a_position, 1.0);
   v_position = world.xyz;
   v_normal = mat3(u_model) * a_normal;  // rigid placements only: no inverse-transpose needed
@@ -32,6 +35,7 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_light_clip;
+in float v_detachment;
 out vec4 o_colour;
 
 uniform int u_material;
@@ -40,6 +44,8 @@ uniform float u_opacity;
 uniform float u_specular;
 uniform float u_shininess;
 uniform bool u_detached;
+uniform vec3 u_detached_colour;
+uniform float u_detached_opacity;
 uniform bool u_has_texture;
 uniform sampler2D u_texture;
 uniform bool u_has_burns;
@@ -98,9 +104,11 @@ float haze_path() {
 }
 
 void main() {
-  vec3 n = normalize(v_normal);
-  if (!gl_FrontFacing) n = -n;  // two-sided: tissue is seen from inside and out
   vec3 v = normalize(u_camera - v_position);
+  // Two-sided: tissue is seen from inside and out, so the normal is turned toward the viewer
+  // (not chosen by winding, which the supplied meshes need not keep consistent).
+  vec3 n = normalize(v_normal);
+  if (dot(n, v) < 0.0) n = -n;
   bool in_gas = u_gas_on && dot(v_position, u_gas_up) > u_gas_level;
 
   vec3 albedo = u_base_colour;
@@ -110,8 +118,11 @@ void main() {
     // Retina: a thin, nearly transparent sheet carrying the vessels (the texture's alpha) over the
     // separate choroid; detached retina is greyish and more opaque, and its vessels move with it.
     vec4 vessels = u_has_texture ? texture(u_texture, v_uv) : vec4(0.0);
-    albedo = mix(u_base_colour, vessels.rgb, vessels.a);
-    alpha = max(u_opacity, vessels.a * (u_detached ? 0.8 : 0.95));
+    float detached = u_detached ? 1.0 : clamp(v_detachment, 0.0, 1.0);
+    vec3 tissue = mix(u_base_colour, u_detached_colour, detached);
+    float tissue_alpha = mix(u_opacity, u_detached_opacity, detached);
+    albedo = mix(tissue, vessels.rgb, vessels.a);
+    alpha = max(tissue_alpha, vessels.a * mix(0.95, 0.8, detached));
   } else if (u_has_texture) {
     vec4 t = texture(u_texture, v_uv);
     albedo *= t.rgb;
@@ -123,10 +134,12 @@ void main() {
     alpha = max(alpha, b);
     specular *= (1.0 - 0.7 * b);  // coagulated tissue is matte
   }
+  float meniscus = 0.0;
   if (u_material == 6) {
-    // Fluid–gas interface seen from above: a faint sheet with a bright meniscus at the wall.
+    // Fluid–gas interface seen from above: a faint sheet with a bright meniscus where it meets the wall.
     float r = length(v_position - u_gas_up * u_gas_level) / max(u_disc_radius, 1e-3);
-    alpha = mix(u_opacity, 0.85, smoothstep(0.82, 0.99, r));
+    meniscus = smoothstep(0.80, 0.98, r);
+    alpha = mix(u_opacity, 0.9, meniscus);
   }
   if (in_gas && u_material != 6) specular *= 2.0;  // tissue under gas looks dry and glossy
 
@@ -145,6 +158,10 @@ void main() {
     vec3 spec_colour = u_material == 5 ? mix(vec3(1.0), albedo, 0.4) : vec3(1.0);  // metal tints its highlight
     lit += radiance * (albedo * diffuse * 1.6 + spec_colour * spec);
     haze_light += kHazeColour * 0.12 * u_light_intensity;  // light scattered by the whole lit cavity
+    // Light bounced off the lit fundus: metal reflects it (instruments are not black silhouettes),
+    // and the meniscus of the gas bubble shines with it.
+    if (u_material == 5) lit += albedo * 0.3 * u_light_intensity * (0.4 + 0.6 * max(-n.z, 0.0));
+    if (u_material == 6) lit += vec3(0.9, 0.92, 0.95) * (0.08 + 0.55 * meniscus) * u_light_intensity;
   }
   float path = haze_path();
   if (in_gas) path *= 0.15;

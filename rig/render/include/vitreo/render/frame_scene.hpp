@@ -41,6 +41,9 @@ struct Vertex {
   Vec3 position_mm;
   Vec3 normal;  // need not be unit length; orientation does not matter (two-sided lighting)
   Vec2 uv;
+  /// Retina only: 0 = attached, 1 = detached (greyish, more opaque); blends in between. Lets one
+  /// mesh carry a local detachment whose border moves as the simulation lifts or reattaches it.
+  float detachment = 0.0f;
 };
 
 /// Vertex data and triangle list of one mesh. Removed tissue is simply absent from `indices`.
@@ -75,7 +78,7 @@ struct Mesh {
   ImagePtr texture;                  // optional; meaning depends on `material`
   Vec3 tint{1, 1, 1};                // multiplies the base colour
   float opacity = -1.0f;             // < 0: the material's default
-  bool detached = false;             // retina only: greyish, more opaque (lifted off the choroid)
+  bool detached = false;             // retina only: the whole mesh is detached (overrides Vertex::detachment)
   std::optional<bool> casts_shadow;  // empty: the material's default (instruments, membranes, detached retina)
   std::vector<LaserBurn> burns;      // all burns so far (append-only within a case; shrinking = reset)
 };
@@ -112,8 +115,8 @@ struct Microscope {
   bool depth_of_field = false;
   float aperture_mm = 3.0f;      // depth-of-field strength
   bool wide_angle = false;       // contact-lens-like wide field from just above the cornea
-  float wide_field_deg = 100.0f;
-  float wide_distance_mm = 24.0f;  // camera distance above the globe centre in wide-angle mode
+  float wide_field_deg = 80.0f;    // vertical field angle in wide-angle mode (reaches the equator)
+  float wide_distance_mm = 16.0f;  // camera height above the globe centre in wide-angle mode (just above the cornea)
 };
 
 struct FrameScene {
