@@ -162,7 +162,27 @@ struct DrawItem {
 
 struct StereoRenderer::Impl {
   RenderSettings s;
-  GLuint scene_program = 0, shadow_program = 0, burn_program = 0;
+  static constexpr std::uint32_t kLight = 1u << 3, kShadows = 1u << 4, kGas = 1u << 5, kTexture = 1u << 6,
+                                 kBurns = 1u << 7;
+  std::unordered_map<std::uint32_t, GLuint> scene_programs;  // shader variant by feature key
+  std::unordered_map<GLuint, std::uint64_t> globals_stamp;    // eye_stamp when its globals were set
+  std::uint64_t eye_stamp = 0;
+  GLuint shadow_program = 0, burn_program = 0;
+
+  GLuint scene_program(std::uint32_t key) {
+    auto it = scene_programs.find(key);
+    if (it != scene_programs.end()) return it->second;
+    const std::string src = "#version 450 core\n#define MATERIAL " + std::to_string(key & 7u) +
+                            "\n#define LIGHT " + std::to_string((key & kLight) ? 1 : 0) +
+                            "\n#define SHADOWS " + std::to_string((key & kShadows) ? 1 : 0) +
+                            "\n#define GAS " + std::to_string((key & kGas) ? 1 : 0) +
+                            "\n#define TEXTURE " + std::to_string((key & kTexture) ? 1 : 0) +
+                            "\n#define BURNS " + std::to_string((key & kBurns) ? 1 : 0) + "\n" +
+                            shaders::kSceneFragmentBody;
+    const GLuint p = link(shaders::kSceneVertex, src.c_str());
+    scene_programs.emplace(key, p);
+    return p;
+  }
   GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
   GLuint shadow_fbo = 0, shadow_tex = 0;
   GLuint burn_vao = 0, burn_vbo = 0;
@@ -191,7 +211,11 @@ struct StereoRenderer::Impl {
 
   explicit Impl(const RenderSettings& settings) : s(settings) {
     if (s.eye_width <= 0 || s.eye_height <= 0) throw RenderError("render: eye size must be positive");
-    scene_program = link(shaders::kSceneVertex, shaders::kSceneFragment);
+    // The common variants up front, so the first frames do not stall on shader compilation.
+    for (std::uint32_t m = 0; m < 6; ++m) {
+      scene_program(m | kLight | kShadows | kTexture);
+      scene_program(m | kLight | kShadows);
+    }
     shadow_program = link(shaders::kShadowVertex, shaders::kShadowFragment);
     burn_program = link(shaders::kBurnVertex, shaders::kBurnFragment);
 
@@ -252,7 +276,7 @@ struct StereoRenderer::Impl {
     for (auto& [id, g] : meshes) release(g);
     release(disc);
     for (auto& [ptr, t] : textures) glDeleteTextures(1, &t.id);
-    glDeleteProgram(scene_program);
+    for (auto& [key, prog] : scene_programs) glDeleteProgram(prog);
     glDeleteProgram(shadow_program);
     glDeleteProgram(burn_program);
     glDeleteFramebuffers(1, &fbo);
@@ -610,62 +634,86 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
 
-  const GLuint p = scene_program;
-  glUseProgram(p);
-  set(p, "u_light_view_projection", light_vp);
-  set(p, "u_light_on", scene.light_pipe.has_value());
-  if (scene.light_pipe) {
-    const LightPipe& lp = *scene.light_pipe;
-    const float half = lp.cone_half_angle_deg * 3.14159265f / 180.0f;
-    set(p, "u_light_position", lp.tip_mm);
-    set(p, "u_light_direction", light_dir);
-    set(p, "u_cos_outer", std::cos(half));
-    set(p, "u_cos_inner", std::cos(0.7f * half));
-    set(p, "u_light_intensity", lp.intensity);
-    set(p, "u_light_range", std::max(lp.range_mm, 1e-3f));
-  }
-  set(p, "u_shadows_on", shadows);
-  set(p, "u_shadow_texel", 1.0f / static_cast<float>(s.shadow_map_size));
-  set(p, "u_ambient", scene.ambient);
-  set(p, "u_globe_radius", scene.globe_radius_mm);
-  set(p, "u_haze_density", scene.haze_density_per_mm);
-  set(p, "u_gas_on", scene.fluid_gas.has_value());
-  if (scene.fluid_gas) {
-    const Vec3 up = normalize(scene.fluid_gas->up);
+  // Per-frame and per-eye uniforms are set on each shader variant the first time it is used for an
+  // eye (variants are separate programs, see shaders.cpp).
+  const bool light_on = scene.light_pipe.has_value();
+  const bool gas_on = scene.fluid_gas.has_value();
+  float light_half = 0, disc_radius = 0;
+  Vec3 gas_up{0, 0, 1};
+  if (light_on) light_half = scene.light_pipe->cone_half_angle_deg * 3.14159265f / 180.0f;
+  if (gas_on) {
+    gas_up = normalize(scene.fluid_gas->up);
     const float R = scene.globe_radius_mm;
     const float h = std::clamp(scene.fluid_gas->level_mm, -R, R);
-    set(p, "u_gas_up", up);
-    set(p, "u_gas_level", scene.fluid_gas->level_mm);
-    set(p, "u_disc_radius", std::sqrt(std::max(R * R - h * h, 0.0f)));
+    disc_radius = std::sqrt(std::max(R * R - h * h, 0.0f));
   }
-  set(p, "u_texture", 0);
-  set(p, "u_burns", 1);
-  set(p, "u_shadow_map", 2);
+  // The image is rendered upside down (y flipped in clip space) so that glReadPixels, which returns
+  // the bottom row first, yields rows top to bottom without a copy. Winding flips too; no culling.
+  Mat4 flip;
+  flip.at(1, 1) = -1.0f;
+  const EyeView* eye_view = nullptr;
+  GLuint current = 0;
+  auto use_variant = [&](std::uint32_t key) {
+    const GLuint p = scene_program(key);
+    if (p != current) {
+      glUseProgram(p);
+      current = p;
+    }
+    std::uint64_t& stamp = globals_stamp[p];
+    if (stamp == eye_stamp) return p;
+    stamp = eye_stamp;
+    set(p, "u_view_projection", flip * eye_view->view_projection);
+    set(p, "u_camera", eye_view->position_mm);
+    set(p, "u_light_view_projection", light_vp);
+    if (light_on) {
+      const LightPipe& lp = *scene.light_pipe;
+      set(p, "u_light_position", lp.tip_mm);
+      set(p, "u_light_direction", light_dir);
+      set(p, "u_cos_outer", std::cos(light_half));
+      set(p, "u_cos_inner", std::cos(0.7f * light_half));
+      set(p, "u_light_intensity", lp.intensity);
+      set(p, "u_light_range", std::max(lp.range_mm, 1e-3f));
+    }
+    set(p, "u_ambient", scene.ambient);
+    set(p, "u_globe_radius", scene.globe_radius_mm);
+    set(p, "u_haze_density", scene.haze_density_per_mm);
+    set(p, "u_gas_on", gas_on);
+    if (gas_on) {
+      set(p, "u_gas_up", gas_up);
+      set(p, "u_gas_level", scene.fluid_gas->level_mm);
+      set(p, "u_disc_radius", disc_radius);
+    }
+    set(p, "u_texture", 0);
+    set(p, "u_burns", 1);
+    set(p, "u_shadow_map", 2);
+    return p;
+  };
   glActiveTexture(GL_TEXTURE2);
   glBindTexture(GL_TEXTURE_2D, shadow_tex);
 
   auto draw_scene_item = [&](const DrawItem& d, int material) {
+    const bool has_tex = d.mesh && d.mesh->texture;
+    const bool has_burns = d.gpu->burn_texture != 0;
+    const std::uint32_t key = static_cast<std::uint32_t>(material) | (light_on ? kLight : 0u) |
+                              (shadows ? kShadows : 0u) | (gas_on ? kGas : 0u) | (has_tex ? kTexture : 0u) |
+                              (has_burns ? kBurns : 0u);
+    const GLuint p = use_variant(key);
     set(p, "u_model", d.mesh ? d.mesh->model : Mat4::identity());
-    set(p, "u_material", material);
     set(p, "u_base_colour", d.look.base_colour);
     set(p, "u_opacity", d.look.opacity);
     set(p, "u_specular", d.look.specular);
     set(p, "u_shininess", d.look.shininess);
-    set(p, "u_detached", d.mesh ? d.mesh->detached : false);
-    if (d.mesh && d.mesh->material == MaterialKind::Retina) {
+    if (material == 0) {
       const Appearance det = default_appearance(MaterialKind::Retina, true);
       const Vec3 t = d.mesh->tint;
+      set(p, "u_detached", d.mesh->detached);
       set(p, "u_detached_colour", Vec3{det.base_colour.x * t.x, det.base_colour.y * t.y, det.base_colour.z * t.z});
       set(p, "u_detached_opacity", d.mesh->detached ? d.look.opacity : det.opacity);
     }
-    const bool has_tex = d.mesh && d.mesh->texture;
-    set(p, "u_has_texture", has_tex);
     if (has_tex) {
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, textures.at(d.mesh->texture.get()).id);
     }
-    const bool has_burns = d.gpu->burn_texture != 0;
-    set(p, "u_has_burns", has_burns);
     if (has_burns) {
       glActiveTexture(GL_TEXTURE1);
       glBindTexture(GL_TEXTURE_2D, d.gpu->burn_texture);
@@ -683,15 +731,10 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   std::stable_sort(translucent.begin(), translucent.end(),
                    [](const DrawItem& a, const DrawItem& b) { return a.sort_distance > b.sort_distance; });
 
-  // The image is rendered upside down (y flipped in clip space) so that glReadPixels, which returns
-  // the bottom row first, yields rows top to bottom without a copy. Winding flips too; no culling.
-  Mat4 flip;
-  flip.at(1, 1) = -1.0f;
   for (int e = 0; e < 2; ++e) {
-    const EyeView& ev = views.eye[e];
+    eye_view = &views.eye[e];
+    ++eye_stamp;
     glViewport(e * s.eye_width, 0, s.eye_width, s.eye_height);
-    set(p, "u_view_projection", flip * ev.view_projection);
-    set(p, "u_camera", ev.position_mm);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     for (const DrawItem& d : opaque) draw_scene_item(d, static_cast<int>(d.mesh->material));
@@ -699,7 +742,7 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glDepthMask(GL_FALSE);
     for (const DrawItem& d : translucent) draw_scene_item(d, static_cast<int>(d.mesh->material));
-    if (scene.fluid_gas && disc.index_count > 0) {
+    if (gas_on && disc.index_count > 0) {
       DrawItem di{nullptr, &disc, {{0.80f, 0.84f, 0.90f}, 0.12f, 1.2f, 80.0f, false}, 0};
       draw_scene_item(di, 6);
     }
