@@ -185,6 +185,34 @@ struct StereoRenderer::Impl {
   }
   GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
   GLuint shadow_fbo = 0, shadow_tex = 0;
+  // Depth of field: the eyes are drawn into textures, then composited into `fbo` (made on first use).
+  GLuint dof_fbo = 0, dof_colour = 0, dof_depth = 0, composite_program = 0, empty_vao = 0;
+  int dof_levels = 0;
+
+  void make_dof_targets() {
+    const int w = 2 * s.eye_width, h = s.eye_height;
+    dof_levels = 1 + static_cast<int>(std::floor(std::log2(std::max(w, h))));
+    glGenTextures(1, &dof_colour);
+    glBindTexture(GL_TEXTURE_2D, dof_colour);
+    glTexStorage2D(GL_TEXTURE_2D, dof_levels, GL_RGBA8, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glGenTextures(1, &dof_depth);
+    glBindTexture(GL_TEXTURE_2D, dof_depth);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT24, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glGenFramebuffers(1, &dof_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, dof_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, dof_colour, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, dof_depth, 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw RenderError("render: depth-of-field framebuffer incomplete");
+    composite_program = link(shaders::kCompositeVertex, shaders::kCompositeFragment);
+    glGenVertexArrays(1, &empty_vao);
+  }
   GLuint burn_vao = 0, burn_vbo = 0;
   GpuMesh disc;  // the fluid–gas interface, rebuilt each frame it is shown
   std::unordered_map<std::uint32_t, GpuMesh> meshes;
@@ -284,6 +312,13 @@ struct StereoRenderer::Impl {
     glDeleteRenderbuffers(1, &depth_rb);
     glDeleteFramebuffers(1, &shadow_fbo);
     glDeleteTextures(1, &shadow_tex);
+    if (dof_fbo) {
+      glDeleteFramebuffers(1, &dof_fbo);
+      glDeleteTextures(1, &dof_colour);
+      glDeleteTextures(1, &dof_depth);
+      glDeleteProgram(composite_program);
+      glDeleteVertexArrays(1, &empty_vao);
+    }
     glDeleteVertexArrays(1, &burn_vao);
     glDeleteBuffers(1, &burn_vbo);
   }
@@ -625,7 +660,9 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   const StereoViews views = stereo_views(scene.microscope, scene.globe_radius_mm, s.eye_width, s.eye_height);
   if (scene.fluid_gas) build_disc(scene, stats);
 
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  const bool dof = scene.microscope.depth_of_field;
+  if (dof && dof_fbo == 0) make_dof_targets();
+  glBindFramebuffer(GL_FRAMEBUFFER, dof ? dof_fbo : fbo);
   glViewport(0, 0, 2 * s.eye_width, s.eye_height);
   glDepthMask(GL_TRUE);
   glClearColor(0, 0, 0, 1);
@@ -748,6 +785,38 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     }
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
+  }
+
+  if (dof) {
+    // Focus: blur each pixel by its circle of confusion (see kCompositeFragment).
+    glBindTexture(GL_TEXTURE_2D, dof_colour);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    const GLuint cp = composite_program;
+    glUseProgram(cp);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, dof_colour);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, dof_depth);
+    set(cp, "u_colour", 0);
+    set(cp, "u_depth", 1);
+    glUniform2f(loc(cp, "u_size"), static_cast<float>(2 * s.eye_width), static_cast<float>(s.eye_height));
+    set(cp, "u_max_lod", static_cast<float>(std::min(dof_levels - 1, 6)));
+    glBindVertexArray(empty_vao);
+    for (int e = 0; e < 2; ++e) {
+      const EyeView& ev = views.eye[e];
+      glViewport(e * s.eye_width, 0, s.eye_width, s.eye_height);
+      glUniform2f(loc(cp, "u_eye_x"), static_cast<float>(e * s.eye_width), static_cast<float>((e + 1) * s.eye_width));
+      set(cp, "u_near", ev.near_mm);
+      set(cp, "u_far", ev.far_mm);
+      set(cp, "u_focus", ev.focus_distance_mm);
+      // Thin lens: blur angle ≈ aperture·|1/z − 1/focus|; pixels per radian = (H/2)·P[1][1].
+      set(cp, "u_coc_scale", scene.microscope.aperture_mm * 0.5f * static_cast<float>(s.eye_height) * ev.projection.at(1, 1));
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    glEnable(GL_DEPTH_TEST);
   }
 
   // ---- 4. read both eyes at once ----

@@ -206,6 +206,40 @@ const char* const kShadowFragment = R"(#version 450 core
 void main() {}
 )";
 
+// Depth of field of the microscope (focus pedal): a full-screen pass per eye that reads the sharp
+// image from a mipmapped texture at a level chosen by the circle of confusion of a thin lens
+// focused at u_focus: coc_px = u_coc_scale·|1/z − 1/focus| (z = depth along the view axis).
+// Mip levels stand in for a blur kernel — cheap on llvmpipe, blockier than a real bokeh.
+const char* const kCompositeVertex = R"(#version 450 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));  // one triangle covering the viewport
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* const kCompositeFragment = R"(#version 450 core
+uniform sampler2D u_colour;
+uniform sampler2D u_depth;
+uniform vec2 u_size;     // whole side-by-side image, pixels
+uniform vec2 u_eye_x;    // this eye's x range, pixels
+uniform float u_near;
+uniform float u_far;
+uniform float u_focus;
+uniform float u_coc_scale;
+uniform float u_max_lod;
+out vec4 o_colour;
+void main() {
+  vec2 px = gl_FragCoord.xy;
+  float d = texelFetch(u_depth, ivec2(px), 0).r;
+  float z = 2.0 * u_near * u_far / (u_far + u_near - (2.0 * d - 1.0) * (u_far - u_near));
+  float coc = u_coc_scale * abs(1.0 / z - 1.0 / u_focus);
+  float lod = clamp(log2(max(coc, 1.0)), 0.0, u_max_lod);
+  float margin = exp2(ceil(lod));  // keep the filter footprint inside this eye's half
+  vec2 uv = vec2(clamp(px.x, u_eye_x.x + margin, u_eye_x.y - margin), px.y) / u_size;
+  o_colour = vec4(textureLod(u_colour, uv, lod).rgb, 1.0);
+}
+)";
+
 // Paints one laser burn into a mesh's burn texture (R8, in the mesh's uv space). The quad covers the
 // burn's footprint in uv; u_metric is the surface metric JᵀJ of the hit triangle (J = d position /
 // d uv), so the burn is a circle of radius_mm on the tissue whatever the uv stretch.

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   std::string out = "snapshot";
   std::string platform = "auto";
   int width = 640, height = 512, tris = 20000;
+  float defocus_mm = 0.0f;
   bool dark = false, detached = false, gas = false, wide = false, burn = false;
   app.add_option("--out", out, "output prefix: <out>_left.png, _right.png, _stereo.png");
   app.add_option("--platform", platform, "EGL platform: auto, surfaceless, device, gbm");
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   app.add_flag("--gas", gas, "fluid-gas exchange");
   app.add_flag("--wide", wide, "wide-angle view");
   app.add_flag("--burn", burn, "a laser burn at the posterior pole");
+  app.add_option("--defocus", defocus_mm, "depth of field on, focus this many mm above the fundus");
   CLI11_PARSE(app, argc, argv);
   try {
     EglOptions egl;
@@ -46,6 +48,11 @@ int main(int argc, char** argv) {
     if (burn) {
       for (auto& m : scene.meshes)
         if (m.id == testing::kRetina) m.burns.push_back({testing::retina_point(14, 250), {}, 0.4f});
+    }
+    if (defocus_mm != 0.0f) {
+      scene.microscope.depth_of_field = true;
+      scene.microscope.focus_distance_mm =
+          scene.microscope.working_distance_mm + scene.microscope.target_mm.z + testing::kRetinaRadius - defocus_mm;
     }
     StereoFrame frame;
     renderer.render(scene, frame);

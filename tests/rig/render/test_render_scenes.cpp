@@ -343,3 +343,36 @@ TEST_F(RenderScenes, UploadsOnlyWhatChangedAndRemovedTissueIsGone) {
   const Rgb with_tool = patch(first.eye(0), px, 0), without_tool = patch(gone.eye(0), px, 0);
   EXPECT_GT(std::fabs(with_tool.luma() - without_tool.luma()) + std::fabs(with_tool.r - without_tool.r), 20.0);
 }
+
+namespace {
+// Sum of absolute horizontal luminance steps over a centred patch: high when sharp.
+double detail(const vr::Image& img) {
+  double sum = 0;
+  for (int y = img.height / 4; y < 3 * img.height / 4; ++y) {
+    for (int x = img.width / 4; x < 3 * img.width / 4; ++x) {
+      const std::uint8_t* a = &img.rgba[(static_cast<std::size_t>(y) * img.width + x) * 4];
+      const std::uint8_t* b = a + 4;
+      sum += std::fabs((0.2126 * a[0] + 0.7152 * a[1] + 0.0722 * a[2]) - (0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2]));
+    }
+  }
+  return sum;
+}
+}  // namespace
+
+TEST_F(RenderScenes, FocusBlursWhatIsOutsideTheFocalPlane) {
+  vt::SyntheticOptions o;
+  o.retina_triangles = 3000;
+  o.instrument = false;
+  vr::FrameScene s = vt::make_scene(o);
+  const double no_dof = detail(render(s).eye(0));
+  s.microscope.depth_of_field = true;
+  // Focused on the fundus near the posterior pole (working distance + depth below the target).
+  s.microscope.focus_distance_mm = s.microscope.working_distance_mm + (s.microscope.target_mm.z + vt::kRetinaRadius);
+  const double focused = detail(render(s).eye(0));
+  s.microscope.focus_distance_mm -= 40.0f;  // focus pedal: the sharp plane 40 mm above the fundus
+  const vr::StereoFrame defocused_frame = render(s);
+  const double defocused = detail(defocused_frame.eye(0));
+  EXPECT_GT(focused, 0.8 * no_dof);
+  EXPECT_LT(defocused, 0.6 * focused);
+  EXPECT_EQ(defocused_frame.step_index, s.step_index);
+}
