@@ -12,7 +12,9 @@ namespace vitreo::render {
 RenderThread::RenderThread(RenderThreadOptions options) : options_(std::move(options)) {
   std::promise<void> started;
   std::future<void> ready = started.get_future();
-  thread_ = std::thread([this, &started] { run(started); });
+  // The promise moves into the thread: this constructor may return (and its locals die) while
+  // set_value() is still finishing there.
+  thread_ = std::thread([this, p = std::move(started)]() mutable { run(p); });
   try {
     ready.get();  // rethrows the start-up failure
   } catch (...) {

@@ -36,7 +36,9 @@ TEST(FrameRing, HeaderMatchesTheDocumentedLayout) {
   vr::FrameRingWriter writer(name, 40, 30, 4);
   vr::FrameRingReader reader(name);
   const vr::FrameRingHeader& h = reader.header();
-  EXPECT_EQ(std::string(h.magic, 8), "VTRFRAME");
+  char magic[8];
+  std::memcpy(magic, &h.magic, 8);
+  EXPECT_EQ(std::string(magic, 8), "VTRFRAME");
   EXPECT_EQ(h.version, 1u);
   EXPECT_EQ(h.width, 80u);
   EXPECT_EQ(h.eye_width, 40u);

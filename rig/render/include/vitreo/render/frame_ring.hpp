@@ -40,7 +40,7 @@
 namespace vitreo::render {
 
 struct FrameRingHeader {
-  char magic[8];
+  std::uint64_t magic;  // the bytes "VTRFRAME" (kFrameRingMagic on a little-endian host); written last
   std::uint32_t version;
   std::uint32_t header_bytes;
   std::uint32_t width;
@@ -67,7 +67,8 @@ struct FrameSlotHeader {
 };
 static_assert(sizeof(FrameSlotHeader) == 64);
 
-inline constexpr char kFrameRingMagic[8] = {'V', 'T', 'R', 'F', 'R', 'A', 'M', 'E'};
+// "VTRFRAME" read as a little-endian u64.
+inline constexpr std::uint64_t kFrameRingMagic = 0x454D415246525456ull;
 inline constexpr std::uint32_t kFrameRingVersion = 1;
 inline constexpr std::uint32_t kFrameFormatRgba8 = 1;
 
