@@ -376,3 +376,51 @@ TEST_F(RenderScenes, FocusBlursWhatIsOutsideTheFocalPlane) {
   EXPECT_LT(defocused, 0.6 * focused);
   EXPECT_EQ(defocused_frame.step_index, s.step_index);
 }
+
+namespace {
+// A flat disc (membrane patch) or a sphere (gel body) as extra meshes for the synthetic scene.
+vr::MeshGeometryPtr disc_mesh(vr::Vec3 centre, float radius) {
+  auto g = std::make_shared<vr::MeshGeometry>();
+  g->vertices.push_back({centre, {0, 0, 1}, {0.5f, 0.5f}});
+  const int n = 32;
+  for (int i = 0; i <= n; ++i) {
+    const float a = 6.2831853f * i / n;
+    g->vertices.push_back({centre + vr::Vec3{radius * std::cos(a), radius * std::sin(a), 0}, {0, 0, 1}, {0.5f, 0.5f}});
+    if (i > 0) g->indices.insert(g->indices.end(), {0u, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
+  }
+  return g;
+}
+}  // namespace
+
+TEST_F(RenderScenes, MembraneIsWhitishAndGelOnlyVeilsTheFundus) {
+  vt::SyntheticOptions o;
+  o.retina_triangles = 3000;
+  o.instrument = false;
+  vr::FrameScene s = vt::make_scene(o);
+  const vr::StereoFrame plain = render(s);
+  // An epiretinal membrane patch 0.8 mm in front of the retina, inside the light cone.
+  const vr::Vec3 centre{1.5f, 1.0f, -11.0f};
+  vr::Mesh membrane;
+  membrane.id = 20;
+  membrane.material = vr::MaterialKind::Membrane;
+  membrane.geometry = disc_mesh(centre, 1.2f);
+  vr::FrameScene with_membrane = s;
+  with_membrane.meshes.push_back(membrane);
+  const vr::Vec2 px = vt::project_to_pixel(s, 0, centre, kW, kH);
+  const Rgb before = patch(plain.eye(0), px), after = patch(render(with_membrane).eye(0), px);
+  EXPECT_LT(after.spread() / after.luma(), 0.6 * before.spread() / before.luma()) << "membrane should be whitish";
+  EXPECT_GT(after.luma(), before.luma());
+  // Vitreous gel filling the cavity: a faint veil — the fundus detail stays mostly visible.
+  vr::Mesh gel;
+  gel.id = 21;
+  gel.material = vr::MaterialKind::Gel;
+  gel.geometry = disc_mesh({0, 0, -6.0f}, 10.0f);
+  vr::FrameScene with_gel = s;
+  with_gel.meshes.push_back(gel);
+  // A whitish veil: the fundus is less saturated, yet its detail stays visible.
+  const vr::StereoFrame veiled = render(with_gel);
+  const vr::Vec2 mid{kW / 2.0f, kH / 2.0f};
+  const Rgb p_plain = patch(plain.eye(0), mid, 20), p_gel = patch(veiled.eye(0), mid, 20);
+  EXPECT_LT(p_gel.spread() / p_gel.luma(), 0.97 * p_plain.spread() / p_plain.luma());
+  EXPECT_GT(detail(veiled.eye(0)), 0.6 * detail(plain.eye(0)));
+}
