@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
 #include <future>
 
 #include "vitreo/render/frame_ring.hpp"
@@ -44,6 +45,25 @@ void RenderThread::stop() {
   wake_.notify_one();
   thread_.join();
 }
+
+std::vector<std::string> RenderThread::pngs_written() const {
+  std::lock_guard lock(mutex_);
+  return pngs_written_;
+}
+
+namespace {
+void write_stereo_pngs(const std::string& prefix, const StereoFrame& frame) {
+  write_png(prefix + "_left.png", frame.eye(0));
+  write_png(prefix + "_right.png", frame.eye(1));
+  write_png(prefix + "_stereo.png", frame.side_by_side());
+}
+
+std::string series_prefix(const std::string& dir, std::uint64_t step) {
+  char name[48];
+  std::snprintf(name, sizeof name, "/step_%09llu", static_cast<unsigned long long>(step));
+  return dir + name;
+}
+}  // namespace
 
 std::optional<std::string> RenderThread::error() const {
   std::lock_guard lock(mutex_);
@@ -88,15 +108,29 @@ void RenderThread::run(std::promise<void>& started) {
         std::lock_guard lock(mutex_);
         prefix.swap(png_prefix_);
       }
-      if (!prefix.empty()) {
-        write_png(prefix + "_left.png", frame.eye(0));
-        write_png(prefix + "_right.png", frame.eye(1));
-        write_png(prefix + "_stereo.png", frame.side_by_side());
+      if (!prefix.empty()) write_stereo_pngs(prefix, frame);
+      const std::uint64_t n = frames_.load(std::memory_order_relaxed) + 1;
+      if (!options_.png_dir.empty() && options_.png_every_frames > 0 && n % options_.png_every_frames == 0) {
+        const std::string p = series_prefix(options_.png_dir, frame.step_index);
+        write_stereo_pngs(p, frame);
+        std::lock_guard lock(mutex_);
+        pngs_written_.push_back(p);
       }
       if (options_.on_frame) options_.on_frame(frame);
       last_step_.store(frame.step_index, std::memory_order_release);
       frames_.fetch_add(1, std::memory_order_acq_rel);
       frames_.notify_all();
+    }
+    // The last frame of the run, unless it was just written as one of the series.
+    if (!options_.png_dir.empty() && frames_.load(std::memory_order_relaxed) > 0) {
+      const std::string p = series_prefix(options_.png_dir, frame.step_index);
+      std::lock_guard lock(mutex_);
+      if (pngs_written_.empty() || pngs_written_.back() != p) {
+        write_stereo_pngs(p, frame);
+        pngs_written_.push_back(p);
+      }
+      spdlog::info("render thread: {} stereo frame(s) written to {} (last: {}_stereo.png)", pngs_written_.size(),
+                   options_.png_dir, pngs_written_.back());
     }
   } catch (const std::exception& e) {
     spdlog::error("render thread stopped: {}", e.what());

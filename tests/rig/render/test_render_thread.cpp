@@ -1,9 +1,12 @@
 // The render thread: fed from a simulated physics thread, it never makes the publisher wait, and
 // every frame it emits shows the sim time and step of the scene it rendered.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <future>
 #include <mutex>
 #include <thread>
@@ -130,4 +133,40 @@ TEST(RenderThread, StartFailureThrowsTheEglReason) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/card9"), std::string::npos) << e.what();
   }
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 10.0);
+}
+
+TEST(RenderThread, WritesAFewStereoFramesAlongTheWayAndTheLast) {
+  const std::string dir = ::testing::TempDir() + "vitreo_series_" + std::to_string(getpid());
+  ASSERT_EQ(mkdir(dir.c_str(), 0755), 0);
+  vr::RenderThreadOptions o = small_options();
+  o.png_dir = dir;
+  o.png_every_frames = 2;
+  std::atomic<std::uint64_t> rendered{0};
+  o.on_frame = [&](const vr::StereoFrame&) {
+    rendered.fetch_add(1);
+    rendered.notify_all();
+  };
+  vr::RenderThread thread(o);
+  vt::SyntheticOptions so;
+  so.retina_triangles = 500;
+  vr::FrameScene scene = vt::make_scene(so);
+  for (std::uint64_t i = 1; i <= 3; ++i) {  // one frame per scene: wait for each before the next
+    scene.step_index = 10 * i;
+    thread.publish(scene);
+    for (std::uint64_t seen = rendered.load(); seen < i; seen = rendered.load()) rendered.wait(seen);
+  }
+  thread.stop();
+  const std::vector<std::string> written = thread.pngs_written();
+  ASSERT_EQ(written.size(), 2u);
+  EXPECT_EQ(written[0], dir + "/step_000000020");  // frame 2 of 3, along the way
+  EXPECT_EQ(written[1], dir + "/step_000000030");  // the last
+  for (const std::string& p : written) {
+    EXPECT_EQ(vr::read_png(p + "_stereo.png").width, 192);
+    EXPECT_EQ(vr::read_png(p + "_left.png").width, 96);
+    std::remove((p + "_stereo.png").c_str());
+    std::remove((p + "_left.png").c_str());
+    std::remove((p + "_right.png").c_str());
+  }
+  EXPECT_THROW(vr::read_png(dir + "/step_000000010_stereo.png"), std::runtime_error);
+  rmdir(dir.c_str());
 }

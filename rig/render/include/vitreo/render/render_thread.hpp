@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/frame_scene.hpp"
@@ -27,6 +28,11 @@ struct RenderThreadOptions {
   RenderSettings render;
   std::string shm_ring_name;  // empty: no shared-memory ring
   int shm_ring_slots = 3;
+  /// Stereo frames of a run as PNGs (issue 8: "a few along the way and the last one"): when set, every
+  /// png_every_frames-th rendered frame (0: none along the way) and the last frame rendered before
+  /// stop() are written to <png_dir>/step_<step>_{left,right,stereo}.png. The directory must exist.
+  std::string png_dir;
+  std::uint64_t png_every_frames = 0;
   /// Called on the render thread after each frame (keep it short; it delays the next frame only).
   std::function<void(const StereoFrame&)> on_frame;
 };
@@ -56,6 +62,8 @@ class RenderThread {
   /// The first error raised on the render thread after start-up (rendering then stops), if any.
   std::optional<std::string> error() const;
   const std::string& context_description() const { return context_description_; }
+  /// Prefixes ("<dir>/step_<step>") of the PNG series written so far (png_dir).
+  std::vector<std::string> pngs_written() const;
 
  private:
   void run(std::promise<void>& started);
@@ -68,6 +76,7 @@ class RenderThread {
   mutable std::mutex mutex_;  // guards png_prefix_ and error_ (never taken by publish())
   std::string png_prefix_;
   std::optional<std::string> error_;
+  std::vector<std::string> pngs_written_;
   std::string context_description_;
   std::thread thread_;
 };
