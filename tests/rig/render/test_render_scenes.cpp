@@ -424,3 +424,25 @@ TEST_F(RenderScenes, MembraneIsWhitishAndGelOnlyVeilsTheFundus) {
   EXPECT_LT(p_gel.spread() / p_gel.luma(), 0.97 * p_plain.spread() / p_plain.luma());
   EXPECT_GT(detail(veiled.eye(0)), 0.6 * detail(plain.eye(0)));
 }
+
+TEST_F(RenderScenes, BurnGivenAsUvMatchesBurnGivenAsPositionAndResetsWithTheCase) {
+  vr::FrameScene s = burn_scene();
+  vr::Mesh* retina = mesh(s, vt::kRetina);
+  retina->burns.clear();
+  const vr::StereoFrame clean = render(s);
+  // The synthetic retina's radial uv mapping (synthetic_scene.cpp): r = 0.5·θ/95°, angle φ.
+  const float theta = 14.0f, phi = 250.0f * 3.14159265f / 180.0f, r = 0.5f * theta / 95.0f;
+  retina->burns = {{vt::retina_point(theta, 250.0f), {}, 0.45f}};
+  const vr::Image by_position = render(s).side_by_side();
+  vr::FrameScene s_uv = s;
+  mesh(s_uv, vt::kRetina)->burns = {{{}, vr::Vec2{0.5f + r * std::cos(phi), 0.5f + r * std::sin(phi)}, 0.45f}};
+  // A fresh renderer, so the burn texture starts clean.
+  renderer_ = std::make_unique<vr::StereoRenderer>(vr::RenderSettings{kW, kH, 512, 512});
+  const vr::Image by_uv = render(s_uv).side_by_side();
+  const vr::ImageDiff d = vr::compare_images(by_uv, by_position, 24);
+  EXPECT_LT(d.rmse, 1.0) << d.summary();
+  EXPECT_GT(vr::compare_images(by_position, clean.side_by_side()).max_abs_diff, 40);  // the burn is there
+  // A new case: the burn list starts again empty, and the old burn is gone.
+  mesh(s_uv, vt::kRetina)->burns.clear();
+  EXPECT_LT(vr::compare_images(render(s_uv).side_by_side(), clean.side_by_side()).rmse, 0.01);
+}
