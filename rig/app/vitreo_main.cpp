@@ -70,6 +70,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> serial_devices;
   bool realtime = false;
   bool verify_replay = true;
+  bool render = true;
+  int eye_width = 640, eye_height = 512;
 
   CLI::App app{"vitreo: vitreoretinal surgery training rig — the real-time simulation process.\n"
                "Default: simulated tracker, pedals and eyeball fixture over ptys drive the retina scene;\n"
@@ -89,6 +91,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_flag("--realtime", realtime, "ask for SCHED_FIFO, locked memory and a dedicated core for physics");
   app.add_flag("!--no-verify", verify_replay, "do not replay the recording at the end");
+  app.add_flag("!--no-render", render, "no stereo frames (EGL) at all");
+  app.add_option("--eye-size", eye_width, "width of each eye's image in pixels (height = 4/5 of it)")
+      ->check(CLI::Range(64, 4096));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -127,6 +132,13 @@ int main(int argc, char** argv) {
     config.lcm_url = lcm_url.empty() ? lcm_file_url(out / "telemetry.lcmlog") : lcm_url;
     config.record_path = (out / "session.lcmlog").string();
     config.realtime = realtime;
+    config.render = render;
+    eye_height = eye_width * 4 / 5;
+    config.eye_width = eye_width;
+    config.eye_height = eye_height;
+    config.png_dir = (out / "frames").string();
+    config.png_every_frames = 10;
+    if (render) std::filesystem::create_directories(config.png_dir);
     config.config_text = "retina-cap vertices=" + std::to_string(retina_vertices) + " substeps=" + std::to_string(substeps);
     if (serial_devices.empty()) {
       const std::string base = "/tmp/vitreo-" + std::to_string(::getpid());
@@ -165,6 +177,11 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(s.telemetry_published), static_cast<unsigned long long>(s.telemetry_dropped),
                 config.lcm_url.c_str());
     std::printf("  recording        %s\n", config.record_path.c_str());
+    if (render) {
+      std::printf("  frames           %llu stereo frames %dx%d per eye (%s); %zu written to %s, the last: %s\n",
+                  static_cast<unsigned long long>(s.frames_rendered), eye_width, eye_height, s.renderer.c_str(), s.pngs.size(),
+                  config.png_dir.c_str(), s.pngs.empty() ? "none" : (s.pngs.back() + "_stereo.png").c_str());
+    }
     std::printf("  state hash       %016llx\n", static_cast<unsigned long long>(s.state_hash));
     if (verify_replay) {
       const auto r = vitreo::rig::replay_session(config.record_path, model);

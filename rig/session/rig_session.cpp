@@ -5,13 +5,17 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <algorithm>
 #include <memory>
+#include <optional>
 
 #include "rig/runtime/clock.hpp"
 #include "rig/runtime/thread_harness.hpp"
 #include "rig/telemetry/commands.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "rig/session/frame_source.hpp"
+#include "vitreo/render/render_thread.hpp"
 
 namespace vitreo::rig {
 
@@ -74,6 +78,22 @@ SessionSummary run_session(const SessionConfig& config) {
     recorder = std::make_unique<telemetry::Recorder>(config.record_path, header);
   }
 
+  // Rendering: created first so an EGL failure stops the session before any device starts.
+  std::unique_ptr<render::RenderThread> renderer;
+  runtime::TripleBuffer<ViewSnapshot> views;
+  std::optional<FrameBuilder> frames;
+  if (config.render) {
+    render::RenderThreadOptions ro;
+    ro.render.eye_width = config.eye_width;
+    ro.render.eye_height = config.eye_height;
+    ro.png_dir = config.png_dir;
+    ro.png_every_frames = config.png_every_frames;
+    renderer = std::make_unique<render::RenderThread>(ro);
+    reserve_view_snapshots(model, views);
+    frames.emplace(config.model.scene.globe_radius_mm, config.model.ports);
+  }
+  const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));
+
   DeviceHub hub(config.devices, &devices_out);
   SessionSummary summary;
   runtime::SteadyClock wall;
@@ -124,6 +144,10 @@ SessionSummary run_session(const SessionConfig& config) {
         if (slots[i].present) physics_out.push(to_state(slots[i], static_cast<int>(i), step, t_s));
       }
     }
+    if (renderer && (k % view_every == 0 || k + 1 == config.steps)) {
+      capture_view(model, k, t_s, views.write_slot());
+      views.publish();
+    }
     if (loop && (k + 1) % 250 == 0) {  // physics timing at 4 Hz, cumulative over the session
       telemetry::PhysicsTiming t = telemetry::timing_item(loop->stats(), k, harness_config.loop.period_ns);
       t.paused = model.paused();
@@ -136,6 +160,17 @@ SessionSummary run_session(const SessionConfig& config) {
     publisher.handle_incoming();
   });
   if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
+  std::uint64_t last_view = ~std::uint64_t{0};
+  auto render_latest = [&] {
+    if (!views.update()) return;
+    const ViewSnapshot& v = views.read_slot();
+    if (v.step == last_view) return;
+    last_view = v.step;
+    renderer->publish(frames->build(v));
+  };
+  if (renderer) {
+    harness.add_service("render", std::chrono::milliseconds(static_cast<int>(1000.0 / config.display_hz)), render_latest);
+  }
 
   hub.start();
   harness.start();
@@ -144,6 +179,15 @@ SessionSummary run_session(const SessionConfig& config) {
   hub.stop();
   if (recorder) recorder->close();
   publisher.pump();
+  if (renderer) {
+    render_latest();  // the final state, so the last frame shows where the session ended
+    renderer->stop();
+    summary.frames_rendered = renderer->frames_rendered();
+    summary.scenes_dropped = renderer->scenes_dropped();
+    summary.pngs = renderer->pngs_written();
+    summary.renderer = renderer->context_description();
+    if (auto err = renderer->error()) throw std::runtime_error("rendering failed: " + *err);
+  }
 
   summary.steps = harness.loop().stats().steps;
   summary.simulated_s = static_cast<double>(summary.steps) * config.model.dt_s;

@@ -25,6 +25,14 @@ struct SessionConfig {
   // Scripted actions at given steps, run on the physics thread (hardware-in-the-loop tests pull a
   // simulated cable with it). Must be quick and wait-free, like everything on that thread.
   std::function<void(std::uint64_t step, DeviceHub& hub)> on_step;
+
+  // Stereo microscope frames (EGL, headless here): rendered on their own thread from snapshots
+  // physics takes at display rate; PNGs of every png_every_frames-th frame and of the last one.
+  bool render = false;
+  int eye_width = 640, eye_height = 512;
+  double display_hz = 30.0;
+  std::string png_dir;
+  std::uint64_t png_every_frames = 0;
 };
 
 struct SessionSummary {
@@ -37,6 +45,9 @@ struct SessionSummary {
   std::uint64_t state_hash = 0;
   std::vector<std::string> device_lines;  // per device: name, link statistics
   std::uint64_t frozen_steps = 0;          // steps during which an instrument was frozen (its tracker lost)
+  std::uint64_t frames_rendered = 0, scenes_dropped = 0;
+  std::vector<std::string> pngs;           // frames written
+  std::string renderer;                    // EGL/GL context in use
 };
 
 // Runs a live session to completion (config.steps) and returns its summary. Throws on setup errors

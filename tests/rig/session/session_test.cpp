@@ -106,3 +106,20 @@ TEST(RigSession, ALostTrackerFreezesItsInstrumentAndTheSessionCarriesOn) {
   EXPECT_GT(frozen_states, 100) << "telemetry shows the instrument frozen while its tracker was lost";
   std::filesystem::remove(config.record_path);
 }
+
+TEST(RigSession, RendersStereoFramesOfTheRunAndTheLastOne) {
+  auto config = small_session("render", 600);
+  config.render = true;
+  config.eye_width = 160;
+  config.eye_height = 128;
+  config.png_dir = temp_path("frames");
+  config.png_every_frames = 5;
+  std::filesystem::create_directories(config.png_dir);
+  const rig::SessionSummary s = rig::run_session(config);
+  EXPECT_GT(s.frames_rendered, 0u);
+  ASSERT_FALSE(s.pngs.empty());
+  // The last frame shows the last step.
+  EXPECT_NE(s.pngs.back().find("step_000000599"), std::string::npos) << s.pngs.back();
+  EXPECT_TRUE(std::filesystem::exists(s.pngs.back() + "_stereo.png")) << s.pngs.back();
+  std::filesystem::remove_all(config.png_dir);
+}
