@@ -59,6 +59,16 @@ telemetry::DeviceInput session_end_marker(std::uint64_t steps) {
   return in;
 }
 
+telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
+  telemetry::DeviceInput in;
+  in.device_kind = kCommandKind;
+  in.sequence = cmd.seq;
+  in.n_values = 2;
+  in.values[0] = static_cast<double>(static_cast<int>(cmd.code));
+  in.values[1] = cmd.value;
+  return in;
+}
+
 }  // namespace
 
 SessionSummary run_session(const SessionConfig& config) {
@@ -106,23 +116,20 @@ SessionSummary run_session(const SessionConfig& config) {
   runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
     if (config.on_step) config.on_step(k, hub);
-    telemetry::AcceptedCommand cmd;
-    while (commands.poll(cmd)) {
-      if (cmd.code == telemetry::CommandCode::Pause) model.set_paused(true);
-      if (cmd.code == telemetry::CommandCode::Resume) model.set_paused(false);
-    }
-    // What the command server validates the next commands against (one case for now).
-    telemetry::CommandContext& context = commands.context().write_slot();
-    context.paused = model.paused();
-    context.case_index = 0;
-    context.case_count = 1;
-    commands.context().publish();
     auto consume = [&](const telemetry::DeviceInput& in) {
       telemetry::DeviceInput stamped = in;
       stamped.step = step;
       if (recorder) recorder->push(stamped);
       model.apply(stamped);
     };
+    telemetry::AcceptedCommand cmd;
+    while (commands.poll(cmd)) consume(command_input(cmd));
+    // What the command server validates the next commands against (one case for now).
+    telemetry::CommandContext& context = commands.context().write_slot();
+    context.paused = model.paused();
+    context.case_index = 0;
+    context.case_count = 1;
+    commands.context().publish();
     hub.take_new(consume);
     if (k + 1 == config.steps) consume(session_end_marker(config.steps));
     const core::StepReport report = model.step();

@@ -19,6 +19,24 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
   bool ok = false;
   if (in.device_kind == kSessionEndKind) {
     ok = true;
+  } else if (in.device_kind == kCommandKind && in.n_values >= 2) {
+    // Codes follow telemetry::CommandCode; case changes and snapshots are the session's business.
+    switch (static_cast<int>(in.values[0])) {
+      case 3: paused_ = true; break;   // Pause
+      case 4: paused_ = false; break;  // Resume
+      case 5:                          // Reset: the case as it was loaded, instruments out
+        scene_ = core::build_retina_cap(config_.scene);
+        pedals_ = PedalMapper(config_.pedals);
+        instruments_ = {};
+        eye_rotation_ = core::Quat::Identity();
+        ++resets_;
+        break;
+      case 7: wireframe_ = !wireframe_; break;
+      case 8: labels_ = !labels_; break;
+      case 9: zoom_override_ = in.values[1]; break;
+      default: break;
+    }
+    ok = true;
   } else if (in.device_kind == kLinkKind && in.n_values >= 1) {
     // Which instrument a tracker link carries is its channel.
     if (in.channel >= 0 && in.channel < static_cast<int>(instruments_.size())) {
@@ -70,6 +88,9 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_u64(scene_.world.state_hash());
   h.add_u64(steps_);
   h.add_u64(applied_);
+  h.add_u64(resets_);
+  h.add_u64((paused_ ? 1u : 0u) | (wireframe_ ? 2u : 0u) | (labels_ ? 4u : 0u));
+  h.add_double(zoom_override_);
   h.add_u64(refused_);
   for (const auto& slot : instruments_) {
     h.add_u64((slot.present ? 1u : 0u) | (slot.frozen ? 2u : 0u) | (slot.pose.inserted ? 4u : 0u));

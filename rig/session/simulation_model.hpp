@@ -22,6 +22,9 @@ inline constexpr std::int8_t kLinkKind = 4;
 enum class LinkInput : int { Up = 1, Lost = 2 };
 // The session's end, recorded at its last step (values[0] = steps run) so a replay knows its length.
 inline constexpr std::int8_t kSessionEndKind = 5;
+// An accepted operator command (values[0] = telemetry::CommandCode, values[1] = its value): pause,
+// reset or zoom change the session, so they are recorded and replayed like device inputs.
+inline constexpr std::int8_t kCommandKind = 6;
 
 struct ModelConfig {
   core::RetinaCapOptions scene;
@@ -48,8 +51,12 @@ class SimulationModel {
   bool apply(const telemetry::DeviceInput& in);
   // One physics step (skipped while paused). Returns the core's report.
   core::StepReport step();
-  void set_paused(bool paused) { paused_ = paused; }
   bool paused() const { return paused_; }
+  // View state the operator sets (wireframe and labels toggles, microscope zoom override).
+  bool wireframe() const { return wireframe_; }
+  bool labels() const { return labels_; }
+  double zoom_override() const { return zoom_override_; }
+  std::uint64_t resets() const { return resets_; }
 
   core::TissueWorld& world() { return scene_.world; }
   const core::TissueWorld& world() const { return scene_.world; }
@@ -70,7 +77,9 @@ class SimulationModel {
   std::array<InstrumentSlot, 4> instruments_{};
   core::Quat eye_rotation_ = core::Quat::Identity();
   bool paused_ = false;
-  std::uint64_t applied_ = 0, refused_ = 0, steps_ = 0;
+  bool wireframe_ = false, labels_ = false;
+  double zoom_override_ = 0.0;  // 0: the pedal's zoom
+  std::uint64_t applied_ = 0, refused_ = 0, steps_ = 0, resets_ = 0;
 };
 
 }  // namespace vitreo::rig
