@@ -142,6 +142,10 @@ class Surface {
     std::uint32_t vertex_a_side = kNone;
     std::uint32_t vertex_b_side = kNone;
   };
+  // Springs shorter than kMinTearRestLength_mm (rest) are refused: each tear halves the springs at
+  // the crack, and a pull held at one spot would otherwise split them without end into ever
+  // smaller pieces (down to zero rest length); the solver then tears the next most strained one.
+  static constexpr double kMinTearRestLength_mm = 0.01;
   TearResult tear_edge(EdgeId e);
 
   // ---- Topology: low-level primitives (core/topology builds cuts, tears and removal on them) --
@@ -182,8 +186,10 @@ class Surface {
     std::uint32_t vertices_removed = 0;
   };
   // Removes triangle t, the springs left without triangles and the vertices left without any
-  // triangle (with their extra mass; line springs to them go too), and separates bow-tie fans.
-  RemoveResult remove_triangle(TriangleId t);
+  // triangle (with their extra mass; line springs to them go too), and separates bow-tie fans —
+  // unless separate_fans is false: a caller removing many triangles at once then calls
+  // separate_vertex_fans on the corners itself, after the last one (check_surface fails until then).
+  RemoveResult remove_triangle(TriangleId t, bool separate_fans = true);
   bool edge_is_line(std::uint32_t e) const { return edge_is_line_[e] != 0; }
   double edge_traction(std::uint32_t e) const { return edge_traction_[e]; }
 

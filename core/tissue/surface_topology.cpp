@@ -207,7 +207,7 @@ std::uint32_t Surface::separate_vertex_fans(VertexId id) {
   return separate_fans(id.index);
 }
 
-Surface::RemoveResult Surface::remove_triangle(TriangleId id) {
+Surface::RemoveResult Surface::remove_triangle(TriangleId id, bool separate) {
   RemoveResult r;
   if (!(id.index < triangle_slots() && tri_alive_[id.index] && tri_generation_[id.index] == id.generation)) {
     r.status = Status::error("remove_triangle: stale or invalid triangle handle");
@@ -253,8 +253,10 @@ Surface::RemoveResult Surface::remove_triangle(TriangleId id) {
     free_vertex(v);
     ++r.vertices_removed;
   }
-  for (auto v : tv) {
-    if (vertex_alive_[v]) separate_fans(v);
+  if (separate) {
+    for (auto v : tv) {
+      if (vertex_alive_[v]) separate_fans(v);
+    }
   }
   return r;
 }

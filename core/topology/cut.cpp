@@ -14,6 +14,7 @@ using topology::segment_triangle;
 void CutSettings::validate() const {
   require_range(band_mm, 0.0, 1.0, "cut: band_mm");
   require_range(snap_fraction, 0.0, 0.25, "cut: snap_fraction");
+  require_range(min_piece_mm, 0.0, 1.0, "cut: min_piece_mm");
   require_range(min_blade_length_mm, 1e-9, 10.0, "cut: min_blade_length_mm");
   require_range(min_swept_area_mm2, 0.0, 10.0, "cut: min_swept_area_mm2");
 }
@@ -133,6 +134,11 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   const std::array<std::array<Vec3, 2>, 4> boundary{{{p0, q0}, {p1, q1}, {p0, p1}, {q0, q1}}};
   std::array<Vec3, 32> ends{};
   std::uint32_t nends = 0;
+  auto add_end = [&](const Vec3& y) {
+    bool known = false;
+    for (std::uint32_t i = 0; i < nends; ++i) known = known || (ends[i] - y).norm() <= std::max(band, 1e-9);
+    if (!known && nends < ends.size()) ends[nends++] = y;
+  };
   for (auto t : triangles_) {
     const auto tv = s.triangle_vertices(t);
     for (const auto& seg : boundary) {
@@ -140,10 +146,12 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
       double sp;
       std::array<double, 3> bary;
       if (!segment_triangle(seg[0], seg[1], s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), sp, bary)) continue;
-      const Vec3 y = seg[0] + sp * (seg[1] - seg[0]);
-      bool known = false;
-      for (std::uint32_t i = 0; i < nends; ++i) known = known || (ends[i] - y).norm() <= std::max(band, 1e-9);
-      if (!known && nends < ends.size()) ends[nends++] = y;
+      add_end(seg[0] + sp * (seg[1] - seg[0]));
+    }
+    // A corner of the quad resting on the triangle (within the band) ends the cut there too.
+    for (const Vec3& c : {p0, q0, p1, q1}) {
+      const Vec3 y = closest_point_on_triangle(c, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]));
+      if ((y - c).norm() <= band) add_end(y);
     }
   }
 
@@ -198,9 +206,14 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     std::array<double, 3> w{n.dot((c - b).cross(y - b)) / n2, n.dot((a - c).cross(y - c)) / n2, 0.0};
     w[2] = 1.0 - w[0] - w[1];
     int zeros = 0, zero_at = 0;
+    const double double_area = std::sqrt(n2);
     for (int j = 0; j < 3; ++j) {
       auto& wj = w[static_cast<std::size_t>(j)];
-      if (wj < snap || wj <= 1e-9) {
+      // Distance to the edge opposite corner j: w_j × 2A / |edge|.
+      const Vec3& e0 = s.position(tv[static_cast<std::size_t>((j + 1) % 3)]);
+      const Vec3& e1 = s.position(tv[static_cast<std::size_t>((j + 2) % 3)]);
+      const double dist = wj * double_area / std::max((e1 - e0).norm(), 1e-300);
+      if (wj < snap || wj <= 1e-9 || dist <= settings_.min_piece_mm) {
         wj = 0.0;
         ++zeros;
         zero_at = j;
@@ -241,11 +254,13 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     if (!crossing(e, t)) continue;
     const auto [a, b] = s.edge_vertices(e);
     if (cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;
-    const double len = (s.position(b) - s.position(a)).norm();
-    if (t < snap || t * len <= band) {
+    // Band in the current shape, the floor on pieces in the rest shape (what the springs keep).
+    const double len = (s.position(b) - s.position(a)).norm(), rest = s.edge_rest_length(e);
+    const double floor_mm = settings_.min_piece_mm;
+    if (t < snap || t * len <= band || t * rest <= floor_mm) {
       mark(a);
       ++r.snapped;
-    } else if (t > 1.0 - snap || (1.0 - t) * len <= band) {
+    } else if (t > 1.0 - snap || (1.0 - t) * len <= band || (1.0 - t) * rest <= floor_mm) {
       mark(b);
       ++r.snapped;
     } else {

@@ -19,7 +19,7 @@
 // Snapping (documented tolerance): a crossing closer than snap_fraction × the spring's length (or
 // the band) to one of its vertices is moved onto that vertex; an end point whose barycentric
 // coordinate to an edge is below snap_fraction goes onto that edge. Nothing is ever moved farther
-// than max(band, snap_fraction × local edge length). The same rule is the sliver rule: no split
+// than max(band, min_piece_mm, snap_fraction × local edge length). The same rule is the sliver rule: no split
 // makes a triangle smaller than snap_fraction of the triangle it came from, so there is no need to
 // merge or collapse slivers afterwards (and nothing is ever switched off).
 //
@@ -48,6 +48,9 @@ struct BladeEdge {
 struct CutSettings {
   double band_mm = 1e-3;         // tolerance band around the swept surface
   double snap_fraction = 0.05;   // see above; in [0, 0.25]
+  // Crossings closer than this to a vertex snap onto it too, so repeated cuts at one spot never
+  // make springs shorter than this (the absolute floor under snap_fraction).
+  double min_piece_mm = 0.005;
   double min_blade_length_mm = 1e-4;
   double min_swept_area_mm2 = 1e-10;
   void validate() const;  // throws InvalidArgument

@@ -15,6 +15,10 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
     r.status = Status::error("tear_spring: at and crack_fraction must lie in [0.1, 0.9]");
     return r;
   }
+  if (s.edge_rest_length(id.index) < 2.0 * settings.min_spring_length_mm) {
+    r.status = Status::error("tear_spring: spring shorter than twice min_spring_length_mm");
+    return r;
+  }
   if (s.edge_is_line(id.index)) {
     r.status = Status::error("tear_spring: line springs have no surface to tear");
     return r;
@@ -69,6 +73,8 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
   for (int i = 0; i < ncrack; ++i) {
     const EdgeId c = crack[static_cast<std::size_t>(i)];
     const auto ev = s.edge_vertices(c.index);
+    // A spoke too short to split (a sliver's): the crack stops at the split point on that side.
+    if (s.edge_rest_length(c.index) < 2.0 * settings.min_spring_length_mm) continue;
     const double t = ev[0] == m ? settings.crack_fraction : 1.0 - settings.crack_fraction;
     const auto tip = s.split_edge(c, t);
     if (!tip.status) continue;
@@ -90,7 +96,7 @@ std::uint32_t propagate_tears(Surface& s, double threshold, std::uint32_t max_te
     std::uint32_t best = kNone;
     double best_strain = threshold;
     for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
-      if (!s.edge_alive(e) || s.edge_is_line(e)) continue;
+      if (!s.edge_alive(e) || s.edge_is_line(e) || s.edge_rest_length(e) < 2.0 * settings.min_spring_length_mm) continue;
       const double strain = s.edge_strain(e);
       if (strain > best_strain) {
         best_strain = strain;

@@ -21,6 +21,11 @@ namespace vitreo::core {
 struct TearSettings {
   double at = 0.5;              // split parameter along the spring, in [0.1, 0.9]
   double crack_fraction = 0.5;  // how far the crack runs toward each opposite vertex, in [0.1, 0.9]
+  // Springs shorter than this (rest length) are not split: each tear halves the springs at its
+  // crack tip, and without a floor a pull held at one spot would split them without end into
+  // ever smaller, stiffer pieces (the thesis had to switch those off). tear_spring refuses them;
+  // propagate_tears passes on to the most strained spring that is long enough.
+  double min_spring_length_mm = 0.01;
 };
 
 struct SpringTearResult {

@@ -14,6 +14,7 @@ void VitrectorSettings::validate() const {
   require_range(coupling, 0.0, 1.0, "vitrector: coupling");
   require_range(leaving_damping_per_s, 0.0, 1e4, "vitrector: leaving_damping_per_s");
   require_range(snap_fraction, 0.0, 0.25, "vitrector: snap_fraction");
+  require_range(min_piece_mm, 0.0, 1.0, "vitrector: min_piece_mm");
   require_range(max_vacuum_mmhg, 0.0, 760.0, "vitrector: max_vacuum_mmhg");
   require_range(max_cut_rate_cpm, 0.0, 1e5, "vitrector: max_cut_rate_cpm");
 }
@@ -182,21 +183,22 @@ void Vitrector::remove(VitrectorStepResult& r) {
       const std::uint32_t outside_v = a_in ? b : a;
       const std::uint32_t inside_v = a_in ? a : b;
       const double t_out = a_in ? 1.0 - t_cross : t_cross;  // distance fraction to the outside end
-      if (t_out < snap) {
+      const double len = s.edge_rest_length(e);  // the floor on pieces is in the rest shape
+      if (t_out < snap || t_out * len < settings_.min_piece_mm) {
         // The outside end is within the tolerance: it joins the removed region.
         if (stamp_[outside_v] != round_) inside_.push_back(outside_v);
         stamp_[outside_v] = round_;
         phi_[outside_v] = 0.0;
         continue;
       }
-      if (1.0 - t_out < snap) {
+      if (1.0 - t_out < snap || (1.0 - t_out) * len < settings_.min_piece_mm) {
         phi_[inside_v] = 0.0;  // the inside end is on the boundary already
         continue;
       }
       crossings_.push_back({s.edge_id(e), t_cross});
     }
   }
-  if (!s.has_room(static_cast<std::uint32_t>(crossings_.size()) + 3, 3 * static_cast<std::uint32_t>(crossings_.size()),
+  if (!s.has_room(static_cast<std::uint32_t>(2 * crossings_.size() + inside_.size()) + 3, 3 * static_cast<std::uint32_t>(crossings_.size()),
                   2 * static_cast<std::uint32_t>(crossings_.size()))) {
     r.status = Status::error("vitrector: pools full (raise the surface capacity)");
     return;
@@ -229,12 +231,16 @@ void Vitrector::remove(VitrectorStepResult& r) {
     if (!all_in) continue;
     const Vec3 centroid = (s.position(tv[0]) + s.position(tv[1]) + s.position(tv[2])) / 3.0;
     if (region(centroid) > 0.0) continue;
-    const auto removed = s.remove_triangle(s.triangle_id(t));
+    const auto removed = s.remove_triangle(s.triangle_id(t), false);
     if (!removed.status) continue;
     ++r.triangles_removed;
     r.vertices_removed += removed.vertices_removed;
     r.removed_area_mm2 += removed.removed_area_mm2;
     r.removed_mass_g += removed.removed_mass_g;
+  }
+  // Bow-ties left by the removal: one vertex per fan (pools were checked for this above).
+  for (auto v : inside_) {
+    if (s.vertex_alive(v)) s.separate_vertex_fans(s.vertex_id(v));
   }
   removed_mass_g_ += r.removed_mass_g;
 }

@@ -37,6 +37,7 @@ struct VitrectorSettings {
   double coupling = 0.02;  // fraction of the port vacuum acting as attraction pressure at the port
   double leaving_damping_per_s = 50.0;
   double snap_fraction = 0.05;
+  double min_piece_mm = 0.005;  // crossings closer than this to a vertex snap onto it too
   double max_vacuum_mmhg = 650.0;
   double max_cut_rate_cpm = 10000.0;
   void validate() const;  // throws InvalidArgument

@@ -65,11 +65,13 @@ TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
   Surface& s = world.surface(si);
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
     const Vec3 p = s.rest_position(v);
-    if (p.x() == 0.0 || p.x() == kW) ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+    if (p.x() == 0.0 || p.x() == kW) {
+      ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+    }
   }
   VitrectorSettings vs;
   Vitrector vit(s, vs);
-  const Vec3 port(2.0, 1.5, 0.5);
+  const Vec3 port(2.0, 1.5, 0.3);
   ASSERT_TRUE(vit.set_pose(port, Vec3(0, 0, -1)));
   ASSERT_TRUE(vit.set_vacuum(400.0));
   ASSERT_TRUE(vit.set_cut_rate(0.0));
@@ -82,8 +84,8 @@ TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
     ASSERT_FALSE(r.cut);
     ASSERT_TRUE(world.step(1e-3).ok);
   }
-  EXPECT_GT(s.position(centre).z(), 0.05) << "suction must lift the tissue toward the port";
-  EXPECT_LT(s.position(centre).z(), 0.5 + 1e-6);
+  EXPECT_GT(s.position(centre).z(), 0.02) << "suction must lift the tissue toward the port";
+  EXPECT_LT(s.position(centre).z(), 0.3 + 1e-6);
   EXPECT_EQ(s.total_mass(), mass0);
   // 6000 cuts per minute at 1 ms steps: one cut every 10 steps; removal until the hole is made.
   ASSERT_TRUE(vit.set_cut_rate(6000.0));
@@ -132,7 +134,8 @@ TEST(Tear, ACrackOpensAtTheStrainedSpringAndEndsInsideTheAdjacentTriangles) {
   const std::uint32_t e = s.find_edge(a, b);
   ASSERT_NE(e, kNone);
   const Vec3 mid = 0.5 * (s.position(a) + s.position(b));
-  const auto r = tear_spring(s, s.edge_id(e));
+  const EdgeId id = s.edge_id(e);
+  const auto r = tear_spring(s, id);
   ASSERT_TRUE(r.status) << r.status.message();
   EXPECT_EQ(r.vertices_added, 4u) << "split point, its copy, and two crack tips";
   const auto report = check_surface(s, ValidityLimits{});
@@ -143,10 +146,11 @@ TEST(Tear, ACrackOpensAtTheStrainedSpringAndEndsInsideTheAdjacentTriangles) {
   const auto boundary = new_boundary(s, kW, kH);
   ASSERT_EQ(boundary.size(), 4u);
   for (const auto& seg : boundary) {
-    EXPECT_LE((seg.a - mid).norm(), 0.5 * kCell + 1e-9);
-    EXPECT_LE((seg.b - mid).norm(), 0.5 * kCell + 1e-9);
+    // Half way to an opposite vertex of the (right-angled) cells: at most half the cell diagonal.
+    EXPECT_LE((seg.a - mid).norm(), 0.5 * std::sqrt(1.25) * kCell + 1e-9);
+    EXPECT_LE((seg.b - mid).norm(), 0.5 * std::sqrt(1.25) * kCell + 1e-9);
   }
-  EXPECT_FALSE(tear_spring(s, s.edge_id(e)).status) << "the torn spring's handle is stale";
+  EXPECT_FALSE(tear_spring(s, id).status) << "the torn spring's handle is stale";
 }
 
 TEST(Tear, PropagatesFromTheMostStrainedSpringWhereThePullIs) {
@@ -155,7 +159,9 @@ TEST(Tear, PropagatesFromTheMostStrainedSpringWhereThePullIs) {
   const std::uint32_t pulled = 6 * (kCols + 1) + 8;
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
     const Vec3 p = s.rest_position(v);
-    if (p.x() > 2.0 + 1e-9) ASSERT_TRUE(s.set_position(s.vertex_id(v), p + Vec3(0.05, 0.0, 0.0)));
+    if (p.x() > 2.0 + 1e-9) {
+      ASSERT_TRUE(s.set_position(s.vertex_id(v), p + Vec3(0.05, 0.0, 0.0)));
+    }
   }
   ASSERT_TRUE(s.set_position(s.vertex_id(pulled), s.rest_position(pulled) + Vec3(0.0, 0.0, 0.2)));
   const auto torn = propagate_tears(s, 0.15, 5);
