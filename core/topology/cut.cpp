@@ -25,6 +25,7 @@ Cutter::Cutter(Surface& surface, CutSettings settings) : surface_(surface), sett
   const std::size_t nt = ne;  // triangle capacity is below the spring capacity
   cut_stamp_.assign(nv, 0);
   cut_degree_.assign(nv, 0);
+  near_rim_.assign(nv, 0);
   edge_stamp_.assign(ne, 0);
   triangle_stamp_.assign(nt, 0);
   candidates_.reserve(nv);
@@ -65,6 +66,9 @@ void Cutter::gather_candidates() {
     if ((x.array() < box_lo_.array()).any() || (x.array() > box_hi_.array()).any()) continue;
     if (!near_swept(x, margin_mm_)) continue;
     candidates_.push_back(v);
+    for (const auto& seg : rim_) {
+      if (topology::distance_to_segment(x, seg[0], seg[1]) <= margin_mm_) near_rim_[v] = stamp_;
+    }
   }
 }
 
@@ -122,6 +126,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
 
   ++stamp_;
   on_cut_.clear();
+  rim_ = {{{p0, q0}, {p1, q1}, {p0, p1}, {q0, q1}}};
   gather_candidates();
   gather_edges();
 
@@ -131,7 +136,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   }
 
   // Ends: the quad's boundary passing through the surface.
-  const std::array<std::array<Vec3, 2>, 4> boundary{{{p0, q0}, {p1, q1}, {p0, p1}, {q0, q1}}};
+  const auto& boundary = rim_;
   std::array<Vec3, 32> ends{};
   std::uint32_t nends = 0;
   auto add_end = [&](const Vec3& y) {
@@ -141,6 +146,8 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   };
   for (auto t : triangles_) {
     const auto tv = s.triangle_vertices(t);
+    // Only triangles near the quad's boundary can hold an end.
+    if (near_rim_[tv[0]] != stamp_ && near_rim_[tv[1]] != stamp_ && near_rim_[tv[2]] != stamp_) continue;
     for (const auto& seg : boundary) {
       if ((seg[1] - seg[0]).squaredNorm() < 1e-24) continue;
       double sp;
@@ -186,7 +193,6 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   // 1. Insert the ends.
   for (std::uint32_t i = 0; i < nends; ++i) {
     const Vec3& y = ends[i];
-    gather_edges();
     std::uint32_t best = kNone;
     double best_d2 = 1e-12;
     for (auto t : triangles_) {
@@ -243,6 +249,10 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
       mark(nv);
       candidates_.push_back(nv);
       ++r.end_points;
+      // The triangles made by the split, for the next end's search.
+      s.for_each_triangle_of(nv, [&](std::uint32_t t, std::uint32_t) {
+        if (triangles_.size() < triangles_.capacity()) triangles_.push_back(t);
+      });
     }
   }
 

@@ -94,6 +94,7 @@ class Cutter {
   std::array<std::array<Vec3, 3>, 2> swept_{};
   std::array<Vec3, 2> swept_normal_{};
   std::array<bool, 2> swept_valid_{};
+  std::array<std::array<Vec3, 2>, 4> rim_{};  // the quad's boundary: blade at both poses, end paths
   Vec3 box_lo_ = Vec3::Zero(), box_hi_ = Vec3::Zero();
   // Scratch, sized once.
   std::uint32_t stamp_ = 0, edge_round_ = 0;
@@ -106,6 +107,7 @@ class Cutter {
   std::vector<Crossing> crossings_;
   std::vector<EdgeId> to_open_;
   std::vector<std::uint8_t> cut_degree_;
+  std::vector<std::uint32_t> near_rim_;  // == stamp_: within the margin of the quad's boundary
 };
 
 }  // namespace vitreo::core
