@@ -44,6 +44,15 @@ Surface::Surface(const SurfaceDescription& d)
               edge_is_line_, edge_generation_, free_edges_);
   reserve_all(tcap, tri_v_, tri_e_, tri_rest_area_, tri_alive_, tri_generation_, free_triangles_);
   next_corner_.reserve(3 * static_cast<std::size_t>(tcap));
+  // Touch the reserved memory now, so that a cut taking new slots during the simulation does not
+  // pay the operating system's first-touch page faults (tens of µs per stroke otherwise).
+  auto prefault = [](auto&... vecs) {
+    ((vecs.resize(vecs.capacity()), vecs.clear()), ...);
+  };
+  prefault(x_, v_, rest_, mass_, inverse_mass_, extra_mass_, vertex_area_, vertex_alive_, fixed_, vertex_generation_,
+           first_corner_, free_vertices_, edge_v_, edge_t_, base_rest_vec_, rest_vec_, rest_len_, stiffness_,
+           edge_traction_, edge_alive_, edge_is_line_, edge_generation_, free_edges_, tri_v_, tri_e_, tri_rest_area_,
+           tri_alive_, tri_generation_, free_triangles_, next_corner_);
   block_awake_.assign((vcap + kSleepBlock - 1) / kSleepBlock, 1);
   block_quiet_steps_.assign(block_awake_.size(), 0);
 

@@ -46,6 +46,8 @@ bool Cutter::near_swept(const Vec3& p, double tolerance) const {
   for (int k = 0; k < 2; ++k) {
     if (!swept_valid_[static_cast<std::size_t>(k)]) continue;
     const auto& s = swept_[static_cast<std::size_t>(k)];
+    // The distance to the plane bounds the distance to the triangle: a cheap rejection first.
+    if (std::abs(swept_normal_[static_cast<std::size_t>(k)].dot(p - s[0])) > tolerance) continue;
     if ((p - closest_point_on_triangle(p, s[0], s[1], s[2])).squaredNorm() <= tolerance * tolerance) return true;
   }
   return false;
