@@ -447,10 +447,6 @@ Surface::TearResult Surface::tear_edge(EdgeId id) {
     result.status = Status::error("tear_edge: line springs have no surface to tear");
     return result;
   }
-  if (rest_len_[e] < kMinTearRestLength_mm) {
-    result.status = Status::error("tear_edge: spring shorter than kMinTearRestLength_mm");
-    return result;
-  }
   const auto tris = edge_t_[e];
   const int ntri = (tris[0] != kNone) + (tris[1] != kNone);
   // Worst case: 2 midpoint vertices + 2 vertices un-pinched at the crack's ends; 6 new springs +

@@ -142,10 +142,6 @@ class Surface {
     std::uint32_t vertex_a_side = kNone;
     std::uint32_t vertex_b_side = kNone;
   };
-  // Springs shorter than kMinTearRestLength_mm (rest) are refused: each tear halves the springs at
-  // the crack, and a pull held at one spot would otherwise split them without end into ever
-  // smaller pieces (down to zero rest length); the solver then tears the next most strained one.
-  static constexpr double kMinTearRestLength_mm = 0.01;
   TearResult tear_edge(EdgeId e);
 
   // ---- Topology: low-level primitives (core/topology builds cuts, tears and removal on them) --
