@@ -26,6 +26,7 @@ Cutter::Cutter(Surface& surface, CutSettings settings) : surface_(surface), sett
   cut_stamp_.assign(nv, 0);
   cut_degree_.assign(nv, 0);
   near_rim_.assign(nv, 0);
+  separated_.assign(nv, 0);
   edge_stamp_.assign(ne, 0);
   triangle_stamp_.assign(nt, 0);
   candidates_.reserve(nv);
@@ -159,6 +160,8 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     }
     // A corner of the quad resting on the triangle (within the band) ends the cut there too.
     for (const Vec3& c : {p0, q0, p1, q1}) {
+      // Cheap rejection: a corner on the triangle lies within a spring's length of its corners.
+      if ((c - s.position(tv[0])).squaredNorm() > margin_mm_ * margin_mm_) continue;
       const Vec3 y = closest_point_on_triangle(c, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]));
       if ((y - c).norm() <= band) add_end(y);
     }
@@ -340,7 +343,9 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   for (const auto& id : to_open_) {
     if (!s.is_current(id)) continue;
     for (auto v : s.edge_vertices(id.index)) {
-      if (s.vertex_alive(v)) r.vertices_added += s.separate_vertex_fans(s.vertex_id(v));
+      if (!s.vertex_alive(v) || separated_[v] == stamp_) continue;  // once per vertex
+      separated_[v] = stamp_;
+      r.vertices_added += s.separate_vertex_fans(s.vertex_id(v));
     }
   }
   r.vertices_added += r.end_points + r.springs_split;

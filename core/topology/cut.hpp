@@ -107,7 +107,7 @@ class Cutter {
   std::vector<Crossing> crossings_;
   std::vector<EdgeId> to_open_;
   std::vector<std::uint8_t> cut_degree_;
-  std::vector<std::uint32_t> near_rim_;  // == stamp_: within the margin of the quad's boundary
+  std::vector<std::uint32_t> near_rim_, separated_;  // == stamp_: within the margin of the quad's boundary
 };
 
 }  // namespace vitreo::core
