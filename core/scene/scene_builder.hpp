@@ -20,7 +20,7 @@ namespace vitreo::core {
 
 struct SettleReport {
   int steps = 0;
-  double rms_speed_mm_s = 0.0;
+  double max_speed_mm_s = 0.0;  // fastest free vertex at the end
   bool settled = false;  // false: the step budget ran out first
   bool ok = true;        // false: a step was rolled back while settling
 };
@@ -70,7 +70,7 @@ struct BuildOptions {
 // Throws InvalidArgument on a description that does not validate or cannot be built.
 Scene build_scene(const SceneDescription& description, const BuildOptions& options = {});
 
-// Runs the world with extra damping until the rms speed is below the threshold (after min_steps) or
+// Runs the world with extra damping until no free vertex moves faster than the threshold (after min_steps) or
 // max_steps have run; then restores the surgery settings and resets time and step count to zero, so
 // the settled state is the case's start.
 SettleReport settle_world(TissueWorld& world, const SettleSpec& spec);

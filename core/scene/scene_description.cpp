@@ -200,7 +200,7 @@ void SceneDescription::validate() const {
   if (settle.min_steps < 0 || settle.min_steps > settle.max_steps) throw InvalidArgument("settle: min_steps must be in [0, max_steps]");
   require_range(settle.dt_s, 1e-4, 0.02, "settle: dt_s");
   require_range(settle.damping_per_s, 0.0, 1000.0, "settle: damping_per_s");
-  require_range(settle.rms_speed_mm_s, 1e-4, 100.0, "settle: rms_speed_mm_s");
+  require_range(settle.max_speed_mm_s, 1e-4, 100.0, "settle: max_speed_mm_s");
 }
 
 }  // namespace vitreo::core

@@ -89,11 +89,11 @@ struct CriterionSpec {
 };
 
 struct SettleSpec {
-  int max_steps = 1500;
-  int min_steps = 50;
+  int max_steps = 800;
+  int min_steps = 100;
   double dt_s = 0.001;
   double damping_per_s = 20.0;
-  double rms_speed_mm_s = 0.5;  // settled when the mass-weighted rms speed falls below
+  double max_speed_mm_s = 1.0;  // settled when no free vertex is faster (mm/s)
 };
 
 struct SceneMaterials {
