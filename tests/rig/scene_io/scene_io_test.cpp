@@ -12,6 +12,7 @@
 
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/snapshot.hpp"
+#include "rig/scene_io/case_loader.hpp"
 #include "rig/scene_io/scene_file.hpp"
 
 namespace vitreo {
@@ -119,6 +120,27 @@ TEST_P(BadScene, GivesFileLineAndReason) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Corpus, BadScene, ::testing::ValuesIn(files_in(kBad)), test_name);
+
+TEST(CaseLoader, SecondLoadComesFromTheCacheWithTheSameState) {
+  const std::string dir = ::testing::TempDir() + "/vitreo-case-cache-test";
+  std::filesystem::remove_all(dir);
+  const std::string path = kScenes + "/exercise_laser_tear.toml";
+  const auto first = scene_io::load_case(path, {dir, false});
+  EXPECT_FALSE(first.from_cache);
+  ASSERT_FALSE(first.cache_file.empty());
+  const auto second = scene_io::load_case(path, {dir, false});
+  EXPECT_TRUE(second.from_cache);
+  EXPECT_EQ(first.scene.world.state_hash(), second.scene.world.state_hash());
+  // A corrupted cache entry is ignored: the case is settled again, to the same state.
+  {
+    std::fstream f(first.cache_file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    f.put('\x55');
+  }
+  const auto third = scene_io::load_case(path, {dir, false});
+  EXPECT_EQ(third.scene.world.state_hash(), first.scene.world.state_hash());
+  std::filesystem::remove_all(dir);
+}
 
 TEST(SceneFiles, MissingFileIsAnError) {
   EXPECT_THROW(scene_io::load_scene_file("/nonexistent/case.toml"), scene_io::SceneError);
