@@ -99,13 +99,13 @@ struct TreeBuilder {
       out.push_back({p, q, width, artery, depth});
       p = q;
       travelled += kStep;
-      width = std::max(0.015, width * (1.0 - 0.012));
+      width = std::max(0.02, width * (1.0 - 0.003));
       if (travelled >= next_branch && depth < 5 && width > 0.03) {
         next_branch = travelled + rng.uniform(1.0, 2.5);
         const double side = rng.uniform() < 0.5 ? -1.0 : 1.0;
         const double child_heading = heading + side * rng.uniform(0.45, 1.0);
         const double child_width = width * rng.uniform(0.55, 0.75);
-        width *= 0.88;
+        width *= 0.92;
         grow(p, child_heading, child_width, artery, depth + 1, 0.0, 0.0, rng.uniform(2.0, 6.0) * (5 - depth) / 5.0 + 1.0);
       }
     }
