@@ -578,6 +578,9 @@ SettleReport settle_world(TissueWorld& world, const SettleSpec& spec) {
   const SolverSettings surgery = world.settings();
   SolverSettings settling = surgery;
   settling.settling_damping_per_s = spec.damping_per_s;
+  // Let still regions (most of the retina, lying on the wall) fall asleep early: settling only has
+  // to follow what still moves.
+  settling.sleep_after_steps = std::min(surgery.sleep_after_steps, 20);
   WorldAccess::set_settings(world, settling);
   // Speed measured as real displacement over the check interval of the fastest free vertex: most
   // of the retina lies still on the wall, so an average would call a rising detachment settled, and
