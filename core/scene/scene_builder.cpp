@@ -328,12 +328,15 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
         if (to_m[t[k]] == kNone) {
           to_m[t[k]] = static_cast<std::uint32_t>(d.mesh.positions.size());
           const Vec3& p = retina_mesh.positions[t[k]];
-          d.mesh.positions.push_back(p);
           from_retina.push_back(t[k]);
           near_disc.push_back((p - eye.optic_disc_mm).norm() < disc_reach ? 1 : 0);
           const bool at_base = spec.kind == MembraneKind::kAnteroposterior &&
                                eye.fundus_coords(p).norm() > eye.fundus_extent_mm - eye.parameters.vitreous_base_mm;
           fixed.push_back(at_base ? 1 : 0);
+          // Anteroposterior traction: the band's anterior end is held by the vitreous base, standing
+          // inward of the retina (anterior PVR), so contraction pulls the retina forward and inward.
+          d.mesh.positions.push_back(at_base ? Vec3(p - p.normalized() * spec.height_mm) : p);
+          if (at_base) from_retina.back() = kNone;
         }
         mt[k] = to_m[t[k]];
       }
@@ -370,6 +373,28 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
     if (strong) ++out.strong_attachments;
   }
   if (out.attachment_count == 0) throw InvalidArgument(what + ": no attachment to the retina (raise its size)");
+
+  if (spec.detach_radius_mm > 0.0) {
+    std::vector<Vec3> pts;
+    for (std::uint32_t v = 0; v < from_retina.size(); ++v) pts.push_back(ms.position(v));
+    PointGrid grid(pts, 1.0);
+    const Surface& rs = world.surface(scene.retina);
+    LocalForceDescription lf;
+    lf.name = spec.name + ".subretinal";
+    lf.surface = scene.retina;
+    lf.pressure_pa = world.environment().intraocular_pressure_pa;
+    for (std::uint32_t v = 0; v < rs.vertex_slots(); ++v) {
+      if (!rs.vertex_alive(v) || rs.is_fixed(v)) continue;
+      double dist = 0.0;
+      (void)grid.nearest(rs.position(v), &dist);
+      if (dist < spec.detach_radius_mm) {
+        const double u = dist / spec.detach_radius_mm;
+        lf.vertices.push_back(v);
+        lf.weights.push_back(std::clamp(1.5 * (1.0 - u * u), 0.0, 1.0));
+      }
+    }
+    if (!lf.vertices.empty()) out.detachment_force = world.add_local_force(lf);
+  }
 
   // Contraction (thesis ch. 2.4: rest lengths scaled down).
   if (spec.kind == MembraneKind::kEpiretinal || spec.kind == MembraneKind::kPerpendicular) {

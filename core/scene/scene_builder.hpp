@@ -31,6 +31,7 @@ struct BuiltMembrane {
   std::uint32_t first_attachment = 0;
   std::uint32_t attachment_count = 0;
   std::uint32_t strong_attachments = 0;
+  std::uint32_t detachment_force = kNone;  // with detach_radius_mm > 0
 };
 
 struct BuiltTear {

@@ -146,6 +146,7 @@ void SceneDescription::validate() const {
     if (m.attachment_stride < 1 || m.attachment_stride > 50) throw InvalidArgument(w + "attachment_stride must be in [1, 50]");
     if (std::isnan(m.weak_break_force_un) || !(m.weak_break_force_un > 0.0)) throw InvalidArgument(w + "weak_break_force_un must be > 0");
     if (std::isnan(m.strong_break_force_un) || !(m.strong_break_force_un > 0.0)) throw InvalidArgument(w + "strong_break_force_un must be > 0");
+    require_range(m.detach_radius_mm, 0.0, 15.0, w + "detach_radius_mm");
     if (m.strong_break_force_un < m.weak_break_force_un) throw InvalidArgument(w + "strong_break_force_un must be >= weak_break_force_un");
   }
   for (const auto& i : instruments) {

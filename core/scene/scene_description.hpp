@@ -60,6 +60,10 @@ struct MembraneSpec {
   int attachment_stride = 3;
   double weak_break_force_un = 40.0;
   double strong_break_force_un = std::numeric_limits<double>::infinity();
+  // Tractional detachment: within this distance (mm) of the membrane, subretinal fluid balances the
+  // intraocular pressure that otherwise holds the retina on the wall, so the traction can lift it
+  // (a local force of IOP toward the centre). 0 = the retina stays pressed on.
+  double detach_radius_mm = 0.0;
 };
 
 enum class GuideKind : std::uint8_t { kCutPath, kLaserRing, kTarget };
