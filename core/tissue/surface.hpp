@@ -225,6 +225,7 @@ class Surface {
   void update_edge_stiffness(std::uint32_t e);
 
  private:
+  friend class WorldAccess;  // snapshots (core/scene/world_access.hpp)
   std::uint32_t allocate_vertex();
   std::uint32_t allocate_edge();
   std::uint32_t allocate_triangle();
