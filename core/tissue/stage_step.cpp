@@ -13,19 +13,27 @@ namespace {
 constexpr double kMaxDt_s = 0.02;
 }
 
+// Only awake vertices can change during a step (sleeping ones are skipped, and wake-ups are applied
+// at its end), so only they need saving.
 void TissueWorld::save_rollback() {
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     auto view = surfaces_[si]->solver_view();
-    std::copy(view.x.begin(), view.x.end(), scratch_[si].rollback_x.begin());
-    std::copy(view.v.begin(), view.v.end(), scratch_[si].rollback_v.begin());
+    Scratch& sc = scratch_[si];
+    for_each_awake_vertex(*surfaces_[si], [&](std::uint32_t v) {
+      sc.rollback_x[v] = view.x[v];
+      sc.rollback_v[v] = view.v[v];
+    });
   }
 }
 
 void TissueWorld::restore_rollback() {
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     auto view = surfaces_[si]->solver_view();
-    std::copy_n(scratch_[si].rollback_x.begin(), view.x.size(), view.x.begin());
-    std::copy_n(scratch_[si].rollback_v.begin(), view.v.size(), view.v.begin());
+    const Scratch& sc = scratch_[si];
+    for_each_awake_vertex(*surfaces_[si], [&](std::uint32_t v) {
+      view.x[v] = sc.rollback_x[v];
+      view.v[v] = sc.rollback_v[v];
+    });
   }
 }
 

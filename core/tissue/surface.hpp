@@ -144,6 +144,51 @@ class Surface {
   };
   TearResult tear_edge(EdgeId e);
 
+  // ---- Topology: low-level primitives (core/topology builds cuts, tears and removal on them) --
+  // Every primitive refuses (changing nothing) on a stale handle, an out-of-range parameter or a
+  // full pool; on success it bumps topology_version(), wakes what it touched, keeps check_surface()
+  // passing and keeps the mass exact (vertex mass = areal density × adjacent rest area / 3 + extra).
+  // Rest vectors of new springs are built from the springs' rest vectors by vector addition (the
+  // undeformed, possibly plastically crept, configuration), never from current positions.
+  struct SplitResult {
+    Status status = Status::ok();
+    std::uint32_t vertex = kNone;  // the new vertex
+  };
+  // True when the pools can take this many more vertices, springs and triangles.
+  bool has_room(std::uint32_t vertices, std::uint32_t edges, std::uint32_t triangles) const;
+  // Inserts a vertex on spring e at parameter t ∈ (0, 1) measured from edge_vertices(e)[0] and splits
+  // each adjacent triangle in two (rest areas t·A and (1 − t)·A, exactly). e's handle goes stale.
+  SplitResult split_edge(EdgeId e, double t);
+  // Inserts a vertex inside triangle t at barycentric coordinates (all > 0, sum 1) and splits it
+  // into three (rest areas λ·A, exactly).
+  SplitResult split_triangle(TriangleId t, const std::array<double, 3>& barycentric);
+  // Gives the second triangle of interior spring e its own copy of the spring, so the two
+  // triangles no longer share it (the first half of opening a cut). Rest vector, traction and the
+  // fan of each end vertex are unchanged until separate_vertex_fans splits them. Refuses a boundary
+  // spring or a line spring.
+  struct DisconnectResult {
+    Status status = Status::ok();
+    std::uint32_t copy = kNone;  // the second triangle's new spring
+  };
+  DisconnectResult disconnect_edge(EdgeId e);
+  // Where v's triangles form several fans (after disconnect_edge or remove_triangle), every fan
+  // after the first moves to a new copy of v (same position, velocity, rest position, fixed flag;
+  // extra mass and attachments stay with v). Returns the number of copies made.
+  std::uint32_t separate_vertex_fans(VertexId v);
+  struct RemoveResult {
+    Status status = Status::ok();
+    double removed_area_mm2 = 0.0;
+    double removed_mass_g = 0.0;  // exact: total_mass() drops by this much
+    std::uint32_t vertices_removed = 0;
+  };
+  // Removes triangle t, the springs left without triangles and the vertices left without any
+  // triangle (with their extra mass; line springs to them go too), and separates bow-tie fans —
+  // unless separate_fans is false: a caller removing many triangles at once then calls
+  // separate_vertex_fans on the corners itself, after the last one (check_surface fails until then).
+  RemoveResult remove_triangle(TriangleId t, bool separate_fans = true);
+  bool edge_is_line(std::uint32_t e) const { return edge_is_line_[e] != 0; }
+  double edge_traction(std::uint32_t e) const { return edge_traction_[e]; }
+
   // ---- Sleeping ------------------------------------------------------------------------------
   // Vertices are grouped in blocks of kSleepBlock consecutive slots (mesh order, so a block is a
   // compact strip of surface). A block at rest for a while sleeps: the solver skips it and its
@@ -180,6 +225,7 @@ class Surface {
   void update_edge_stiffness(std::uint32_t e);
 
  private:
+  friend class WorldAccess;  // snapshots (core/scene/world_access.hpp)
   std::uint32_t allocate_vertex();
   std::uint32_t allocate_edge();
   std::uint32_t allocate_triangle();
@@ -192,7 +238,13 @@ class Surface {
   void attach_triangle_to_edge(std::uint32_t e, std::uint32_t t);
   void detach_triangle_from_edge(std::uint32_t e, std::uint32_t t);
   void refresh_rest(std::uint32_t e);
-  void separate_fans(std::uint32_t v);
+  std::uint32_t separate_fans(std::uint32_t v);
+  void free_vertex(std::uint32_t v);
+  void refresh_around(std::uint32_t v);
+  // The spring's rest vector oriented from vertex `from` (which must be one of its ends).
+  Vec3 oriented_rest(std::uint32_t e, std::uint32_t from) const {
+    return edge_v_[e][0] == from ? base_rest_vec_[e] : Vec3(-base_rest_vec_[e]);
+  }
 
   TissueMaterial material_;
   bool contained_by_globe_ = true;
@@ -226,6 +278,7 @@ class Surface {
   std::vector<std::uint8_t> block_awake_;
   std::vector<std::uint16_t> block_quiet_steps_;
   std::uint64_t topology_version_ = 0;
+  std::uint32_t line_springs_ = 0;
 };
 
 // Raw arrays handed to the solver (no copies). Valid until the next topology change.

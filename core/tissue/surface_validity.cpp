@@ -111,4 +111,32 @@ ValidityReport check_surface(const Surface& s) {
   return r;
 }
 
+ValidityReport check_surface(const Surface& s, const ValidityLimits& limits) {
+  ValidityReport r = check_surface(s);
+  auto fail = [&](const std::string& what) {
+    if (r.problems.size() < 100) r.problems.push_back(what);
+  };
+  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+    if (s.edge_alive(e) && !s.edge_is_line(e) && s.edge_triangles(e)[0] == kNone) {
+      fail("spring " + std::to_string(e) + " belongs to no triangle");
+    }
+  }
+  const double min_cos = std::cos(limits.min_rest_angle_deg * 3.14159265358979323846 / 180.0);
+  for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+    if (!s.triangle_alive(t)) continue;
+    if (s.triangle_rest_area(t) < limits.min_rest_area_mm2) {
+      fail("triangle " + std::to_string(t) + " rest area " + std::to_string(s.triangle_rest_area(t)) + " below the limit");
+    }
+    if (limits.min_rest_angle_deg <= 0.0) continue;
+    const auto v = s.triangle_vertices(t);
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const Vec3 a = s.rest_position(v[(k + 1) % 3]) - s.rest_position(v[k]);
+      const Vec3 b = s.rest_position(v[(k + 2) % 3]) - s.rest_position(v[k]);
+      const double c = a.dot(b) / (a.norm() * b.norm());
+      if (!(c <= min_cos)) fail("triangle " + std::to_string(t) + " has a rest angle below the limit");
+    }
+  }
+  return r;
+}
+
 }  // namespace vitreo::core

@@ -231,6 +231,7 @@ class TissueWorld {
   std::uint32_t total_blocks() const;
 
  private:
+  friend class WorldAccess;  // snapshots and settling (core/scene/world_access.hpp)
   struct Attachment {
     AttachmentDescription d;
     VertexId a, b;

@@ -1,0 +1,148 @@
+#pragma once
+// A surgical case as data: anatomy, pathology, materials (with the source of every value),
+// instruments, guides and completion criteria. Parsed from TOML by rig/scene_io; built into a
+// TissueWorld by build_scene (scene_builder.hpp). The core never reads TOML.
+//
+// Locations on the fundus are (polar_deg, azimuth_deg): polar angle from the posterior pole
+// (0 = fovea, the ora serrata lies near 80–90°), azimuth 0 = nasal (+x), 90 = superior (+y),
+// 180 = temporal, 270 = inferior.
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/anatomy/eye_model.hpp"
+#include "core/tissue/material.hpp"
+
+namespace vitreo::core {
+
+inline constexpr int kSceneFormatVersion = 1;
+
+struct FundusLocation {
+  double polar_deg = 0.0;
+  double azimuth_deg = 0.0;
+};
+
+// Subretinal fluid: the thesis' local radial force pulling the retina toward the centre (ch. 2.4).
+struct DetachmentSpec {
+  std::string name = "detachment";
+  FundusLocation center;
+  double radius_deg = 20.0;
+  double pressure_pa = 150.0;  // net inward, on top of intraocular pressure
+};
+
+// A horseshoe (U) tear: the U's apex points posterior, its open end (the hinge, where the flap stays
+// attached) anterior, the flap curls inward by up to lift_mm at the apex (a 3-D flap).
+struct TearSpec {
+  std::string name = "tear";
+  FundusLocation center;
+  double width_mm = 2.0;
+  double length_mm = 3.0;
+  double lift_mm = 0.8;
+};
+
+enum class MembraneKind : std::uint8_t { kPerpendicular, kCircumferential, kAnteroposterior, kEpiretinal };
+enum class AttachmentStrength : std::uint8_t { kWeak, kStrong, kMixed };
+
+// Fibrovascular tissue attached to the retina through instance vertices (thesis ch. 2.3.1, 2.4),
+// contracting by rest-length scaling.
+struct MembraneSpec {
+  std::string name = "membrane";
+  MembraneKind kind = MembraneKind::kEpiretinal;
+  FundusLocation center;
+  double size_mm = 4.0;     // radius (epiretinal), band length (circumferential, anteroposterior, perpendicular)
+  double width_mm = 1.5;    // band width
+  double height_mm = 2.0;   // perpendicular sheet: height toward the centre
+  double rest_length_scale = 0.9;  // < 1 contracts
+  AttachmentStrength strength = AttachmentStrength::kMixed;
+  double strong_fraction = 0.25;   // kMixed: share of strong attachments (epiretinal: those at the disc are strong)
+  int attachment_stride = 3;
+  double weak_break_force_un = 40.0;
+  double strong_break_force_un = std::numeric_limits<double>::infinity();
+  // Tractional detachment: within this distance (mm) of the membrane, subretinal fluid balances the
+  // intraocular pressure that otherwise holds the retina on the wall, so the traction can lift it
+  // (a local force of IOP toward the centre). 0 = the retina stays pressed on.
+  double detach_radius_mm = 0.0;
+};
+
+enum class GuideKind : std::uint8_t { kCutPath, kLaserRing, kTarget };
+struct GuideSpec {
+  std::string name;
+  GuideKind kind = GuideKind::kCutPath;
+  std::vector<FundusLocation> points;  // cut path / target: the polyline
+  FundusLocation center;               // laser ring
+  double radius_mm = 1.5;
+  std::string around;                  // laser ring around this tear (its centre), optional
+};
+
+enum class CriterionKind : std::uint8_t {
+  kGelRemoved,        // fraction of gel vertices removed ≥ threshold
+  kMembraneRemoved,   // fraction of a membrane's area removed ≥ threshold
+  kMembraneReleased,  // fraction of a membrane's attachments broken or cut ≥ threshold
+  kPathCut,           // fraction of a cut path guide followed within tolerance ≥ threshold
+  kLaserCoverage,     // fraction of a laser ring covered by spots ≥ threshold
+  kDrained,           // detachment force scale ≤ threshold
+  kRetinaFlat,        // largest retina lift from the wall (mm) ≤ threshold
+  kTimeLimit,         // elapsed s ≤ threshold
+};
+struct CriterionSpec {
+  CriterionKind kind = CriterionKind::kGelRemoved;
+  std::string target;  // membrane / guide / detachment name where the kind needs one
+  double threshold = 0.9;
+};
+
+struct SettleSpec {
+  int max_steps = 800;
+  int min_steps = 100;
+  double dt_s = 0.001;
+  double damping_per_s = 20.0;
+  double max_speed_mm_s = 1.0;  // settled when no free vertex is faster (mm/s)
+};
+
+struct SceneMaterials {
+  TissueMaterial retina;
+  TissueMaterial gel;
+  TissueMaterial membrane;
+  // sources["retina"]["membrane_modulus_pa_mm"] = "Wollensak & Spoerl 2004; ..."
+  std::map<std::string, std::map<std::string, std::string>> sources;
+};
+
+struct SceneDescription {
+  int format_version = kSceneFormatVersion;
+  std::string name;
+  std::string title;
+  std::string summary;
+  std::string category = "case";  // "case" or "exercise"
+  EyeParameters anatomy;
+  std::uint64_t texture_seed = 1;
+  int texture_size_px = 1024;
+  double intraocular_pressure_mmhg = 15.0;
+  int substeps = 2;
+  double gel_adhesion_break_force_un = 30.0;  // cortex ↔ retina, per attachment
+  int gel_adhesion_stride = 2;
+  SceneMaterials materials;
+  std::vector<DetachmentSpec> detachments;
+  std::vector<TearSpec> tears;
+  std::vector<MembraneSpec> membranes;
+  std::vector<std::string> instruments;
+  std::vector<GuideSpec> guides;
+  std::vector<CriterionSpec> criteria;
+  SettleSpec settle;
+  std::string source_file;  // where it was read from (diagnostics)
+
+  // Checks cross-references and ranges; throws InvalidArgument naming the item.
+  void validate() const;
+};
+
+const char* to_string(MembraneKind k);
+const char* to_string(AttachmentStrength s);
+const char* to_string(GuideKind k);
+const char* to_string(CriterionKind k);
+// Names accepted for instruments.
+const std::vector<std::string>& known_instruments();
+
+// Default materials with their sources (the values the scene files start from).
+SceneMaterials default_materials();
+
+}  // namespace vitreo::core

@@ -1,0 +1,38 @@
+#pragma once
+// Exact snapshots of the physical state of a TissueWorld: every position, velocity, rest vector,
+// pool, free list, generation, sleeping counter, attachment, force and solver scratch value, so a
+// world loaded from a snapshot steps on in the same bits as the one that was saved.
+//
+// A snapshot is restored into a world built from the same scene (build_scene with settle = false is
+// enough): the static parts (globe wall, pool capacities) come from the scene, the state from the
+// file. Format (little-endian):
+//   "VTRSNAP\0" | u32 version | u32 flags (0) | u64 payload bytes | u64 FNV-1a-64 of the payload | payload
+// payload = scene name, state hash, then the world state (world_access.cpp). Files are written to a
+// temporary name and renamed, so a reader never sees half a snapshot.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/common/status.hpp"
+#include "core/tissue/tissue_world.hpp"
+
+namespace vitreo::core {
+
+inline constexpr std::uint32_t kSnapshotVersion = 1;
+
+struct SnapshotInfo {
+  std::uint32_t version = 0;
+  std::string scene_name;
+  std::uint64_t state_hash = 0;
+};
+
+std::vector<std::uint8_t> encode_snapshot(const TissueWorld& world, const std::string& scene_name);
+// Validates magic, version, size and checksum, then that the state fits the world; on any error the
+// world is unchanged. Afterwards world.state_hash() equals the hash recorded at save time.
+Status decode_snapshot(TissueWorld& world, std::span<const std::uint8_t> bytes, SnapshotInfo* info = nullptr);
+
+Status save_snapshot(const TissueWorld& world, const std::string& scene_name, const std::string& path);
+Status load_snapshot(TissueWorld& world, const std::string& path, SnapshotInfo* info = nullptr);
+
+}  // namespace vitreo::core

@@ -1,0 +1,358 @@
+#include "core/topology/cut.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/common/validate.hpp"
+#include "core/topology/geometry.hpp"
+
+namespace vitreo::core {
+
+using topology::closest_point_on_triangle;
+using topology::segment_triangle;
+
+void CutSettings::validate() const {
+  require_range(band_mm, 0.0, 1.0, "cut: band_mm");
+  require_range(snap_fraction, 0.0, 0.25, "cut: snap_fraction");
+  require_range(min_piece_mm, 0.0, 1.0, "cut: min_piece_mm");
+  require_range(min_blade_length_mm, 1e-9, 10.0, "cut: min_blade_length_mm");
+  require_range(min_swept_area_mm2, 0.0, 10.0, "cut: min_swept_area_mm2");
+}
+
+Cutter::Cutter(Surface& surface, CutSettings settings) : surface_(surface), settings_(settings) {
+  settings_.validate();
+  const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
+  const std::size_t nt = ne;  // triangle capacity is below the spring capacity
+  cut_stamp_.assign(nv, 0);
+  cut_degree_.assign(nv, 0);
+  near_rim_.assign(nv, 0);
+  separated_.assign(nv, 0);
+  edge_stamp_.assign(ne, 0);
+  triangle_stamp_.assign(nt, 0);
+  candidates_.reserve(nv);
+  on_cut_.reserve(nv);
+  triangles_.reserve(nt);
+  edges_.reserve(ne);
+  crossings_.reserve(ne);
+  to_open_.reserve(ne);
+  double longest = 0.0;
+  for (std::uint32_t e = 0; e < surface.edge_slots(); ++e) {
+    if (surface.edge_alive(e)) longest = std::max(longest, surface.edge_rest_length(e));
+  }
+  // A spring may be stretched up to its tear strain; twice its rest length covers every material's.
+  margin_mm_ = 2.0 * longest + settings_.band_mm;
+}
+
+bool Cutter::near_swept(const Vec3& p, double tolerance) const {
+  for (int k = 0; k < 2; ++k) {
+    if (!swept_valid_[static_cast<std::size_t>(k)]) continue;
+    const auto& s = swept_[static_cast<std::size_t>(k)];
+    // The distance to the plane bounds the distance to the triangle: a cheap rejection first.
+    if (std::abs(swept_normal_[static_cast<std::size_t>(k)].dot(p - s[0])) > tolerance) continue;
+    if ((p - closest_point_on_triangle(p, s[0], s[1], s[2])).squaredNorm() <= tolerance * tolerance) return true;
+  }
+  return false;
+}
+
+void Cutter::mark(std::uint32_t v) {
+  if (cut_stamp_[v] == stamp_) return;
+  cut_stamp_[v] = stamp_;
+  on_cut_.push_back(v);
+}
+
+void Cutter::gather_candidates() {
+  candidates_.clear();
+  const Surface& s = surface_;
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+    if (!s.vertex_alive(v)) continue;
+    const Vec3& x = s.position(v);
+    if ((x.array() < box_lo_.array()).any() || (x.array() > box_hi_.array()).any()) continue;
+    if (!near_swept(x, margin_mm_)) continue;
+    candidates_.push_back(v);
+    for (const auto& seg : rim_) {
+      if (topology::distance_to_segment(x, seg[0], seg[1]) <= margin_mm_) near_rim_[v] = stamp_;
+    }
+  }
+}
+
+// Triangles and springs around the candidate vertices (deduplicated, in a fixed order).
+void Cutter::gather_edges() {
+  ++edge_round_;
+  triangles_.clear();
+  edges_.clear();
+  const Surface& s = surface_;
+  for (auto v : candidates_) {
+    if (!s.vertex_alive(v)) continue;
+    s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+      if (triangle_stamp_[t] == edge_round_) return;
+      triangle_stamp_[t] = edge_round_;
+      triangles_.push_back(t);
+      for (auto e : s.triangle_edges(t)) {
+        if (edge_stamp_[e] == edge_round_) continue;
+        edge_stamp_[e] = edge_round_;
+        edges_.push_back(e);
+      }
+    });
+  }
+}
+
+CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
+  CutResult r;
+  Surface& s = surface_;
+  if (!is_finite(from.a_mm) || !is_finite(from.b_mm) || !is_finite(to.a_mm) || !is_finite(to.b_mm)) {
+    r.status = Status::error("cut: non-finite blade pose");
+    return r;
+  }
+  if ((from.b_mm - from.a_mm).norm() < settings_.min_blade_length_mm ||
+      (to.b_mm - to.a_mm).norm() < settings_.min_blade_length_mm) {
+    r.status = Status::error("cut: degenerate blade (cutting edge shorter than min_blade_length_mm)");
+    return r;
+  }
+  const Vec3 &p0 = from.a_mm, &q0 = from.b_mm, &p1 = to.a_mm, &q1 = to.b_mm;
+  swept_[0] = {p0, q0, q1};
+  swept_[1] = {p0, q1, p1};
+  double area = 0.0;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Vec3 n = (swept_[k][1] - swept_[k][0]).cross(swept_[k][2] - swept_[k][0]);
+    const double a = 0.5 * n.norm();
+    area += a;
+    swept_valid_[k] = a > 1e-14;
+    swept_normal_[k] = swept_valid_[k] ? Vec3(n.normalized()) : Vec3::Zero();
+  }
+  if (!(area > settings_.min_swept_area_mm2) || (!swept_valid_[0] && !swept_valid_[1])) {
+    r.status = Status::error("cut: degenerate sweep (the blade did not sweep any area)");
+    return r;
+  }
+  const double band = settings_.band_mm, snap = settings_.snap_fraction;
+  box_lo_ = p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1).array() - margin_mm_;
+  box_hi_ = p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1).array() + margin_mm_;
+
+  ++stamp_;
+  on_cut_.clear();
+  rim_ = {{{p0, q0}, {p1, q1}, {p0, p1}, {q0, q1}}};
+  gather_candidates();
+  gather_edges();
+
+  // Vertices on the swept surface (vertex and grazing cases).
+  for (auto v : candidates_) {
+    if (near_swept(s.position(v), band)) mark(v);
+  }
+
+  // Ends: the quad's boundary passing through the surface.
+  const auto& boundary = rim_;
+  std::array<Vec3, 32> ends{};
+  std::uint32_t nends = 0;
+  auto add_end = [&](const Vec3& y) {
+    bool known = false;
+    for (std::uint32_t i = 0; i < nends; ++i) known = known || (ends[i] - y).norm() <= std::max(band, 1e-9);
+    if (!known && nends < ends.size()) ends[nends++] = y;
+  };
+  for (auto t : triangles_) {
+    const auto tv = s.triangle_vertices(t);
+    // Only triangles near the quad's boundary can hold an end.
+    if (near_rim_[tv[0]] != stamp_ && near_rim_[tv[1]] != stamp_ && near_rim_[tv[2]] != stamp_) continue;
+    for (const auto& seg : boundary) {
+      if ((seg[1] - seg[0]).squaredNorm() < 1e-24) continue;
+      double sp;
+      std::array<double, 3> bary;
+      if (!segment_triangle(seg[0], seg[1], s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), sp, bary)) continue;
+      add_end(seg[0] + sp * (seg[1] - seg[0]));
+    }
+    // A corner of the quad resting on the triangle (within the band) ends the cut there too.
+    for (const Vec3& c : {p0, q0, p1, q1}) {
+      // Cheap rejection: a corner on the triangle lies within a spring's length of its corners.
+      if ((c - s.position(tv[0])).squaredNorm() > margin_mm_ * margin_mm_) continue;
+      const Vec3 y = closest_point_on_triangle(c, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]));
+      if ((y - c).norm() <= band) add_end(y);
+    }
+  }
+
+  // Crossings, first estimate (for the capacity check only).
+  auto crossing = [&](std::uint32_t e, double& t) {
+    const auto [a, b] = s.edge_vertices(e);
+    const Vec3 &xa = s.position(a), &xb = s.position(b);
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (!swept_valid_[k]) continue;
+      const double da = swept_normal_[k].dot(xa - swept_[k][0]);
+      const double db = swept_normal_[k].dot(xb - swept_[k][0]);
+      if (!(da * db < 0.0)) continue;
+      t = da / (da - db);
+      const Vec3 x = xa + t * (xb - xa);
+      const Vec3 c = closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2]);
+      if ((x - c).squaredNorm() <= band * band + 1e-24) return true;
+    }
+    return false;
+  };
+  std::uint32_t ncross = 0;
+  for (auto e : edges_) {
+    double t;
+    if (crossing(e, t)) ++ncross;
+  }
+  const std::uint32_t k = nends + ncross + static_cast<std::uint32_t>(on_cut_.size()) + 2;
+  if (!s.has_room(3 * k, 6 * k, 3 * k)) {
+    r.status = Status::error("cut: pools full (raise the surface capacity)");
+    return r;
+  }
+  if (nends == 0 && ncross == 0 && on_cut_.empty()) return r;  // the blade missed the tissue
+
+  // 1. Insert the ends.
+  for (std::uint32_t i = 0; i < nends; ++i) {
+    const Vec3& y = ends[i];
+    std::uint32_t best = kNone;
+    double best_d2 = 1e-12;
+    for (auto t : triangles_) {
+      if (!s.triangle_alive(t)) continue;
+      const auto tv = s.triangle_vertices(t);
+      const double d2 = (y - closest_point_on_triangle(y, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]))).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = t;
+      }
+    }
+    if (best == kNone) continue;
+    const auto tv = s.triangle_vertices(best);
+    const Vec3 &a = s.position(tv[0]), &b = s.position(tv[1]), &c = s.position(tv[2]);
+    const Vec3 n = (b - a).cross(c - a);
+    const double n2 = n.squaredNorm();
+    std::array<double, 3> w{n.dot((c - b).cross(y - b)) / n2, n.dot((a - c).cross(y - c)) / n2, 0.0};
+    w[2] = 1.0 - w[0] - w[1];
+    int zeros = 0, zero_at = 0;
+    const double double_area = std::sqrt(n2);
+    for (int j = 0; j < 3; ++j) {
+      auto& wj = w[static_cast<std::size_t>(j)];
+      // Distance to the edge opposite corner j: w_j × 2A / |edge|.
+      const Vec3& e0 = s.position(tv[static_cast<std::size_t>((j + 1) % 3)]);
+      const Vec3& e1 = s.position(tv[static_cast<std::size_t>((j + 2) % 3)]);
+      const double dist = wj * double_area / std::max((e1 - e0).norm(), 1e-300);
+      if (wj < snap || wj <= 1e-9 || dist <= settings_.min_piece_mm) {
+        wj = 0.0;
+        ++zeros;
+        zero_at = j;
+      }
+    }
+    std::uint32_t nv = kNone;
+    if (zeros >= 2) {
+      nv = tv[static_cast<std::size_t>(std::max_element(w.begin(), w.end()) - w.begin())];
+      if (cut_stamp_[nv] != stamp_) ++r.snapped;
+    } else if (zeros == 1) {
+      const auto j1 = static_cast<std::size_t>((zero_at + 1) % 3), j2 = static_cast<std::size_t>((zero_at + 2) % 3);
+      const std::uint32_t e = s.triangle_edges(best)[j1];  // joins corners j1 and j2
+      const double along = w[j2] / (w[j1] + w[j2]);
+      const double t = s.edge_vertices(e)[0] == tv[j1] ? along : 1.0 - along;
+      const auto split = s.split_edge(s.edge_id(e), t);
+      if (!split.status) continue;
+      nv = split.vertex;
+      ++r.springs_split;
+    } else {
+      const double sum = w[0] + w[1] + w[2];
+      for (auto& wj : w) wj /= sum;
+      const auto split = s.split_triangle(s.triangle_id(best), w);
+      if (!split.status) continue;
+      nv = split.vertex;
+    }
+    if (nv != kNone && cut_stamp_[nv] != stamp_) {
+      mark(nv);
+      candidates_.push_back(nv);
+      ++r.end_points;
+      // The triangles made by the split, for the next end's search.
+      s.for_each_triangle_of(nv, [&](std::uint32_t t, std::uint32_t) {
+        if (triangles_.size() < triangles_.capacity()) triangles_.push_back(t);
+      });
+    }
+  }
+
+  // 2. Crossings: snap onto a vertex within the tolerance, otherwise split the spring there.
+  gather_edges();
+  crossings_.clear();
+  for (auto e : edges_) {
+    double t;
+    if (!crossing(e, t)) continue;
+    const auto [a, b] = s.edge_vertices(e);
+    if (cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;
+    // Band in the current shape, the floor on pieces in the rest shape (what the springs keep).
+    const double len = (s.position(b) - s.position(a)).norm(), rest = s.edge_rest_length(e);
+    const double floor_mm = settings_.min_piece_mm;
+    if (t < snap || t * len <= band || t * rest <= floor_mm) {
+      mark(a);
+      ++r.snapped;
+    } else if (t > 1.0 - snap || (1.0 - t) * len <= band || (1.0 - t) * rest <= floor_mm) {
+      mark(b);
+      ++r.snapped;
+    } else {
+      crossings_.push_back({s.edge_id(e), t});
+    }
+  }
+  for (const auto& c : crossings_) {
+    const auto [a, b] = s.edge_vertices(c.edge.index);
+    if (!s.is_current(c.edge) || cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;
+    const auto split = s.split_edge(c.edge, c.t);
+    if (!split.status) continue;
+    mark(split.vertex);
+    ++r.springs_split;
+  }
+
+  // 3. Springs along the cut.
+  ++edge_round_;
+  to_open_.clear();
+  auto on_cut = [&](std::uint32_t v) { return cut_stamp_[v] == stamp_; };
+  for (auto v : on_cut_) cut_degree_[v] = 0;
+  for (std::size_t i = 0; i < on_cut_.size(); ++i) {
+    const std::uint32_t v = on_cut_[i];
+    s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+      for (auto e : s.triangle_edges(t)) {
+        if (edge_stamp_[e] == edge_round_) continue;
+        edge_stamp_[e] = edge_round_;
+        const auto [a, b] = s.edge_vertices(e);
+        if (!on_cut(a) || !on_cut(b) || s.edge_triangles(e)[1] == kNone) continue;
+        const Vec3 mid = 0.5 * (s.position(a) + s.position(b));
+        const double len = (s.position(b) - s.position(a)).norm();
+        if (!near_swept(mid, band + snap * len)) continue;
+        to_open_.push_back(s.edge_id(e));
+        if (cut_degree_[a] < 255) ++cut_degree_[a];
+        if (cut_degree_[b] < 255) ++cut_degree_[b];
+      }
+    });
+  }
+  auto interior = [&](std::uint32_t v) {
+    bool in = true;
+    s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+      for (auto e : s.triangle_edges(t)) in = in && s.edge_triangles(e)[1] != kNone;
+    });
+    return in;
+  };
+  const std::size_t nopen = to_open_.size();
+  for (std::size_t i = 0; i < nopen; ++i) {
+    const EdgeId id = to_open_[i];
+    if (s.edge_triangles(id.index)[1] == kNone) continue;  // already a boundary: nothing to open
+    const auto [a, b] = s.edge_vertices(id.index);
+    if (cut_degree_[a] != 1 || cut_degree_[b] != 1 || !interior(a) || !interior(b)) continue;
+    // A slit of one spring could not open: give it a middle vertex.
+    const auto split = s.split_edge(id, 0.5);
+    if (!split.status) continue;
+    const std::uint32_t m = split.vertex;
+    mark(m);
+    cut_degree_[m] = 2;
+    to_open_[i] = s.edge_id(s.find_edge(a, m));
+    to_open_.push_back(s.edge_id(s.find_edge(m, b)));
+    ++r.springs_split;
+  }
+  for (const auto& id : to_open_) {
+    if (!s.is_current(id) || s.edge_triangles(id.index)[1] == kNone) continue;
+    if (s.disconnect_edge(id).status) ++r.springs_opened;
+  }
+  for (const auto& id : to_open_) {
+    if (!s.is_current(id)) continue;
+    for (auto v : s.edge_vertices(id.index)) {
+      if (!s.vertex_alive(v) || separated_[v] == stamp_) continue;  // once per vertex
+      separated_[v] = stamp_;
+      r.vertices_added += s.separate_vertex_fans(s.vertex_id(v));
+    }
+  }
+  r.vertices_added += r.end_points + r.springs_split;
+  for (auto v : on_cut_) {
+    if (s.vertex_alive(v)) s.wake_vertex(v);
+  }
+  return r;
+}
+
+}  // namespace vitreo::core

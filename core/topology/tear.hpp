@@ -1,0 +1,43 @@
+#pragma once
+// Tearing that starts where the tissue is pulled (thesis ch. 2.6.2.3, issue 3 item 4).
+//
+// tear_spring splits an overstrained spring at the strained spot (parameter `at`, the middle by
+// default) and opens a short crack across it: in each adjacent triangle the crack runs from the
+// split point toward the opposite vertex for `crack_fraction` of the way and ends there, inside the
+// triangle (a crack tip), instead of cutting through to the far vertex. The springs at the crack
+// tip then carry the load, so the next tear starts there: propagate_tears tears the most strained
+// spring, re-measures, and repeats — the crack grows from where the forceps pull.
+//
+// Built on Surface::split_edge / disconnect_edge / separate_vertex_fans: rest vectors by vector
+// addition, mass exact, check_surface() passes after every tear. Surface::tear_edge (used by the
+// solver's own end-of-step tearing) keeps its older behaviour; see core/topology/README.md.
+#include <cstdint>
+
+#include "core/common/status.hpp"
+#include "core/tissue/surface.hpp"
+
+namespace vitreo::core {
+
+struct TearSettings {
+  double at = 0.5;              // split parameter along the spring, in [0.1, 0.9]
+  double crack_fraction = 0.5;  // how far the crack runs toward each opposite vertex, in [0.1, 0.9]
+  // Springs shorter than this (rest length) are not split: each tear halves the springs at its
+  // crack tip, and without a floor a pull held at one spot would split them without end into
+  // ever smaller, stiffer pieces (the thesis had to switch those off). tear_spring refuses them;
+  // propagate_tears passes on to the most strained spring that is long enough.
+  double min_spring_length_mm = 0.01;
+};
+
+struct SpringTearResult {
+  Status status = Status::ok();
+  std::uint32_t vertices_added = 0;
+};
+
+SpringTearResult tear_spring(Surface& surface, EdgeId spring, const TearSettings& settings = {});
+
+// Tears, one at a time, the most strained triangle spring whose strain exceeds `strain_threshold`,
+// up to max_tears. Returns how many were torn. O(springs) per tear; meant for the step boundary.
+std::uint32_t propagate_tears(Surface& surface, double strain_threshold, std::uint32_t max_tears,
+                              const TearSettings& settings = {});
+
+}  // namespace vitreo::core

@@ -1,0 +1,107 @@
+#include "rig/input/controls.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+namespace vitreo::rig {
+
+namespace {
+bool bit(std::uint16_t switches, int index) { return index >= 0 && index < 16 && ((switches >> index) & 1u) != 0; }
+}  // namespace
+
+bool PedalMapper::apply(const PedalReading& r) {
+  if (r.axis_count < 0 || r.axis_count > 4) return false;
+  for (int i = 0; i < r.axis_count; ++i) {
+    if (!std::isfinite(r.axes[i]) || r.axes[i] < 0.0 || r.axes[i] > 1.0) return false;
+  }
+  auto axis = [&](int index) { return index >= 0 && index < r.axis_count ? r.axes[index] : 0.0; };
+  if (r.pedal_id == m_.vitrectomy_pedal_id) {
+    c_.vacuum_mmhg = axis(m_.vacuum_axis) * m_.vacuum_max_mmhg;
+    const double travel = m_.cut_rate_axis >= 0 ? axis(m_.cut_rate_axis) : 1.0;
+    c_.cut_rate_cpm = c_.vacuum_mmhg > 0.0 ? m_.cut_rate_min_cpm + travel * (m_.cut_rate_max_cpm - m_.cut_rate_min_cpm) : 0.0;
+    c_.reflux = bit(r.switches, m_.reflux_switch);
+    c_.laser_fire = bit(r.switches, m_.laser_switch);
+    if (bit(r.switches, m_.instrument_switch) && !bit(last_switches_[0], m_.instrument_switch)) ++c_.instrument_changes;
+    last_switches_[0] = r.switches;
+  } else if (r.pedal_id == m_.microscope_pedal_id) {
+    c_.zoom = m_.zoom_min + axis(m_.zoom_axis) * (m_.zoom_max - m_.zoom_min);
+    c_.focus_offset_mm = (axis(m_.focus_axis) - 0.5) * m_.focus_range_mm;
+    if (bit(r.switches, m_.light_up_switch) && !bit(last_switches_[1], m_.light_up_switch)) {
+      c_.light_level = std::min(1.0, c_.light_level + m_.light_step);
+    }
+    if (bit(r.switches, m_.light_down_switch) && !bit(last_switches_[1], m_.light_down_switch)) {
+      c_.light_level = std::max(0.0, c_.light_level - m_.light_step);
+    }
+    last_switches_[1] = r.switches;
+  }
+  return true;
+}
+
+PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string& origin) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, origin);
+  } catch (const toml::parse_error& e) {
+    throw std::runtime_error(origin + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  PedalMapping m;
+  const toml::table* pedals = root["pedals"].as_table();
+  if (!pedals) throw std::runtime_error(origin + ": missing [pedals] section");
+  struct Field {
+    double* real = nullptr;
+    int* integer = nullptr;
+    double lo, hi;
+  };
+  const std::map<std::string, Field> fields = {
+      {"vitrectomy_pedal_id", {nullptr, &m.vitrectomy_pedal_id, 0, 255}},
+      {"vacuum_axis", {nullptr, &m.vacuum_axis, 0, 3}},
+      {"vacuum_max_mmhg", {&m.vacuum_max_mmhg, nullptr, 0, 800}},
+      {"cut_rate_axis", {nullptr, &m.cut_rate_axis, -1, 3}},
+      {"cut_rate_min_cpm", {&m.cut_rate_min_cpm, nullptr, 0, 20000}},
+      {"cut_rate_max_cpm", {&m.cut_rate_max_cpm, nullptr, 0, 20000}},
+      {"reflux_switch", {nullptr, &m.reflux_switch, -1, 15}},
+      {"laser_switch", {nullptr, &m.laser_switch, -1, 15}},
+      {"instrument_switch", {nullptr, &m.instrument_switch, -1, 15}},
+      {"microscope_pedal_id", {nullptr, &m.microscope_pedal_id, 0, 255}},
+      {"zoom_axis", {nullptr, &m.zoom_axis, -1, 3}},
+      {"focus_axis", {nullptr, &m.focus_axis, -1, 3}},
+      {"zoom_min", {&m.zoom_min, nullptr, 0.1, 40}},
+      {"zoom_max", {&m.zoom_max, nullptr, 0.1, 40}},
+      {"focus_range_mm", {&m.focus_range_mm, nullptr, 0, 40}},
+      {"light_up_switch", {nullptr, &m.light_up_switch, -1, 15}},
+      {"light_down_switch", {nullptr, &m.light_down_switch, -1, 15}},
+      {"light_step", {&m.light_step, nullptr, 0, 1}},
+  };
+  for (const auto& [key, node] : *pedals) {
+    const std::string where = origin + ":" + std::to_string(node.source().begin.line) + ": pedals." + std::string(key.str());
+    const auto it = fields.find(std::string(key.str()));
+    if (it == fields.end()) throw std::runtime_error(where + ": unknown key");
+    const Field& f = it->second;
+    double value;
+    if (auto i = node.value<std::int64_t>(); i && node.is_integer()) {
+      value = static_cast<double>(*i);
+    } else if (auto d = node.value<double>(); d && f.real) {
+      value = *d;
+    } else {
+      throw std::runtime_error(where + (f.integer ? ": must be an integer" : ": must be a number"));
+    }
+    if (!std::isfinite(value) || value < f.lo || value > f.hi) {
+      throw std::runtime_error(where + ": " + std::to_string(value) + " is outside [" + std::to_string(f.lo) + ", " +
+                               std::to_string(f.hi) + "]");
+    }
+    if (f.integer) {
+      *f.integer = static_cast<int>(value);
+    } else {
+      *f.real = value;
+    }
+  }
+  if (m.zoom_max < m.zoom_min) throw std::runtime_error(origin + ": pedals.zoom_max is below zoom_min");
+  if (m.cut_rate_max_cpm < m.cut_rate_min_cpm) throw std::runtime_error(origin + ": pedals.cut_rate_max_cpm is below cut_rate_min_cpm");
+  return m;
+}
+
+}  // namespace vitreo::rig

@@ -1,0 +1,72 @@
+#pragma once
+// Foot pedals → surgical controls, from a mapping configuration.
+//
+// The vitrectomy pedal's travel sets vacuum (and, on dual-linear pedals, its side travel the cut
+// rate); its switches fire the laser, reflux, and change instrument. The microscope pedal sets zoom,
+// focus and light. Which axis or switch does what is configuration, since rigs differ
+// (rig/config/default-rig.toml).
+#include <cstdint>
+#include <string>
+
+namespace vitreo::rig {
+
+struct PedalMapping {
+  int vitrectomy_pedal_id = 0;
+  int vacuum_axis = 0;
+  double vacuum_max_mmhg = 650.0;
+  int cut_rate_axis = 1;  // -1: fixed cut rate
+  double cut_rate_min_cpm = 1500.0;
+  double cut_rate_max_cpm = 10000.0;
+  int reflux_switch = 0;
+  int laser_switch = 1;
+  int instrument_switch = 2;
+
+  int microscope_pedal_id = 1;
+  int zoom_axis = 0;
+  int focus_axis = 1;
+  double zoom_min = 1.0;
+  double zoom_max = 4.0;
+  double focus_range_mm = 6.0;  // focus travels ±half of this about the working plane
+  int light_up_switch = 0;
+  int light_down_switch = 1;
+  double light_step = 0.1;
+};
+
+struct SurgicalControls {
+  double vacuum_mmhg = 0.0;
+  double cut_rate_cpm = 0.0;
+  bool reflux = false;
+  bool laser_fire = false;
+  std::uint32_t instrument_changes = 0;  // rising edges of the instrument switch so far
+  double zoom = 1.0;
+  double focus_offset_mm = 0.0;
+  double light_level = 0.7;  // 0..1 of the light source
+};
+
+struct PedalReading {
+  int pedal_id = 0;
+  int axis_count = 0;
+  double axes[4] = {};
+  std::uint16_t switches = 0;
+};
+
+class PedalMapper {
+ public:
+  explicit PedalMapper(PedalMapping mapping = {}) : m_(mapping) {}
+  // Applies a reading. Returns false (controls unchanged) for a non-finite or out-of-range axis:
+  // a broken pedal must not open the vacuum.
+  bool apply(const PedalReading& reading);
+  const SurgicalControls& controls() const { return c_; }
+  const PedalMapping& mapping() const { return m_; }
+
+ private:
+  PedalMapping m_;
+  SurgicalControls c_;
+  std::uint16_t last_switches_[2] = {0, 0};
+};
+
+// Reads a mapping from TOML text (section [pedals]); unknown keys and out-of-range values are
+// errors reported as "<origin>:<line>: <key>: <reason>". Throws std::runtime_error.
+PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string& origin);
+
+}  // namespace vitreo::rig

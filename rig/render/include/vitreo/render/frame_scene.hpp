@@ -1,0 +1,144 @@
+#pragma once
+// FrameScene: everything the renderer needs to draw one stereo frame, and nothing more.
+//
+// The simulation (core/) publishes an immutable snapshot per physics step; the rig converts it into a
+// FrameScene and puts it into the render mailbox. The renderer never looks at core/ types, so the two
+// can evolve apart. Heavy data (vertex arrays, index lists, textures) is held through shared_ptr to
+// const, so copying a FrameScene is cheap and the data cannot change under the render thread.
+//
+// Units and frame: millimetres, seconds; the *eye frame* has its origin at the globe centre and +z
+// anterior (toward the microscope). The patient is supine and the surgeon looks down −z through the
+// microscope, so "deeper into the eye" is "downward" for the surgeon — the orientation the thesis'
+// surgeons asked for after complaining the prototype's axes were reversed.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "vitreo/render/math.hpp"
+
+namespace vitreo::render {
+
+/// An RGBA8 image, rows top to bottom (row 0 is v = 0 in texture space).
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;  // width*height*4
+};
+using ImagePtr = std::shared_ptr<const Image>;
+
+/// How a surface looks. The defaults for each kind are in default_appearance().
+enum class MaterialKind : std::uint8_t {
+  Retina,      // `texture` = vessel map: rgb vessel colour, a = vessel coverage; blended over the choroid
+  Choroid,     // `texture` = choroid colour (opaque)
+  Static,      // sclera, lens, iris, ports: opaque, `texture` or tint
+  Membrane,    // epiretinal / fibrovascular membrane: whitish, translucent
+  Gel,         // vitreous gel: hazy, mostly transparent
+  Instrument,  // metallic
+};
+
+struct Vertex {
+  Vec3 position_mm;
+  Vec3 normal;  // need not be unit length; orientation does not matter (two-sided lighting)
+  Vec2 uv;
+  /// Retina only: 0 = attached, 1 = detached (greyish, more opaque); blends in between. Lets one
+  /// mesh carry a local detachment whose border moves as the simulation lifts or reattaches it.
+  float detachment = 0.0f;
+};
+
+/// Vertex data and triangle list of one mesh. Removed tissue is simply absent from `indices`.
+struct MeshGeometry {
+  std::vector<Vertex> vertices;
+  std::vector<std::uint32_t> indices;  // 3 per triangle
+};
+using MeshGeometryPtr = std::shared_ptr<const MeshGeometry>;
+
+/// A laser burn on one mesh, painted once into that mesh's burn texture (in its uv space, so the
+/// burn moves with the tissue and sits exactly where the ray hit, not at the nearest vertex — the
+/// thesis' "geometry dependence" complaint). Give the hit either as a surface point (the renderer
+/// finds the triangle and its barycentric uv) or directly as uv.
+struct LaserBurn {
+  std::optional<Vec3> hit_position_mm;  // on the mesh's *current* surface
+  std::optional<Vec2> hit_uv;           // used when hit_position_mm is empty
+  float radius_mm = 0.25f;              // soft edge from 0.6·radius out to radius
+};
+
+struct Mesh {
+  /// Stable identity across frames: GPU buffers and burn textures are cached by id.
+  std::uint32_t id = 0;
+  MaterialKind material = MaterialKind::Static;
+  MeshGeometryPtr geometry;
+  /// Bump when the vertex data changed (deforming tissue: every step). Positions/normals/uv are
+  /// re-uploaded only when this differs from the last frame; static meshes keep 0 forever.
+  std::uint64_t geometry_version = 0;
+  /// Bump when `indices` changed (cuts, removal). Indices are re-uploaded only then.
+  std::uint64_t topology_version = 0;
+  /// Rigid placement (instruments move without re-uploading their vertices).
+  Mat4 model = Mat4::identity();
+  ImagePtr texture;                  // optional; meaning depends on `material`
+  Vec3 tint{1, 1, 1};                // multiplies the base colour
+  float opacity = -1.0f;             // < 0: the material's default
+  bool detached = false;             // retina only: the whole mesh is detached (overrides Vertex::detachment)
+  std::optional<bool> casts_shadow;  // empty: the material's default (instruments, membranes, detached retina)
+  std::vector<LaserBurn> burns;      // all burns so far (append-only within a case; shrinking = reset)
+};
+
+/// The light pipe (endoilluminator): a spotlight from its tip. Absent → the interior is dark but for
+/// the dim ambient term.
+struct LightPipe {
+  Vec3 tip_mm;
+  Vec3 direction{0, 0, -1};      // need not be unit length
+  float cone_half_angle_deg = 40.0f;
+  float intensity = 1.0f;        // 1 = nominal; scales the spot's radiance
+  float range_mm = 18.0f;        // distance at which the light has fallen to half (1/(1+(d/range)²))
+};
+
+/// Fluid–gas exchange: everything on the `up` side of the plane dot(p, up) = level_mm is gas.
+struct FluidGas {
+  Vec3 up{0, 0, 1};              // opposite gravity, in the eye frame (supine patient: +z)
+  float level_mm = 0.0f;
+};
+
+/// The stereo operating microscope (or the wide-angle contact-lens view).
+struct Microscope {
+  Vec3 target_mm{0, 0, -8};      // look-at point; the working plane passes through it, normal to the view
+  Vec3 image_up{0, 1, 0};        // eye-frame direction that appears upward in the image
+  float working_distance_mm = 180.0f;  // objective to working plane (surgical microscopes: 175–225)
+  float stereo_base_mm = 22.0f;  // interpupillary offset at the objective (left eye at −base/2)
+  float zoom = 1.0f;             // magnification factor; field of view ∝ 1/zoom
+  float field_mm = 30.0f;        // field diameter (vertical) on the working plane at zoom 1
+  /// Convergence (zero disparity) distance; ≤ 0: at the working plane.
+  float convergence_distance_mm = -1.0f;
+  /// Focus: distance of the sharp plane; ≤ 0: at the working plane. Out-of-focus depths are
+  /// blurred when depth_of_field is on.
+  float focus_distance_mm = -1.0f;
+  bool depth_of_field = false;
+  float aperture_mm = 3.0f;      // depth-of-field strength
+  bool wide_angle = false;       // contact-lens-like wide field from just above the cornea
+  float wide_field_deg = 80.0f;    // vertical field angle in wide-angle mode (reaches the equator)
+  float wide_distance_mm = 16.0f;  // camera height above the globe centre in wide-angle mode (just above the cornea)
+};
+
+struct FrameScene {
+  double sim_time_s = 0.0;
+  std::uint64_t step_index = 0;
+  std::vector<Mesh> meshes;
+  std::optional<LightPipe> light_pipe;
+  std::optional<FluidGas> fluid_gas;
+  Microscope microscope;
+  float globe_radius_mm = 12.0f;  // inner radius of the globe: bounds the haze and the gas bubble
+  float ambient = 0.025f;         // dim ambient (stray light through the sclera and pupil)
+  float haze_density_per_mm = 0.02f;  // infusion/vitreous scattering
+};
+
+/// Per-kind defaults used when a Mesh leaves opacity / casts_shadow unset.
+struct Appearance {
+  Vec3 base_colour;
+  float opacity;
+  float specular;
+  float shininess;
+  bool casts_shadow;
+};
+Appearance default_appearance(MaterialKind kind, bool detached);
+
+}  // namespace vitreo::render

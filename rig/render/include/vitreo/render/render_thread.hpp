@@ -1,0 +1,84 @@
+#pragma once
+// RenderThread: renders the latest FrameScene on its own thread, with its own EGL context.
+//
+// The physics side only calls publish(), which is wait-free (LatestSlot): rendering can never slow
+// the simulation down; if rendering is slower than physics, intermediate scenes are skipped (and
+// counted). Each rendered frame carries the sim time and step index of the scene it shows and is
+// handed to the sinks: the shared-memory ring (if named), PNG files on request, and a callback.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "vitreo/render/egl_context.hpp"
+#include "vitreo/render/frame_scene.hpp"
+#include "vitreo/render/latest_slot.hpp"
+#include "vitreo/render/renderer.hpp"
+
+namespace vitreo::render {
+
+struct RenderThreadOptions {
+  EglOptions egl;
+  RenderSettings render;
+  std::string shm_ring_name;  // empty: no shared-memory ring
+  int shm_ring_slots = 3;
+  /// Stereo frames of a run as PNGs (issue 8: "a few along the way and the last one"): when set, every
+  /// png_every_frames-th rendered frame (0: none along the way) and the last frame rendered before
+  /// stop() are written to <png_dir>/step_<step>_{left,right,stereo}.png. The directory must exist.
+  std::string png_dir;
+  std::uint64_t png_every_frames = 0;
+  /// Called on the render thread after each frame (keep it short; it delays the next frame only).
+  std::function<void(const StereoFrame&)> on_frame;
+};
+
+class RenderThread {
+ public:
+  /// Starts the thread and waits until its EGL context and renderer exist; throws EglError /
+  /// RenderError / std::runtime_error (with the reason) if they cannot be created.
+  explicit RenderThread(RenderThreadOptions options);
+  ~RenderThread();  // stops and joins
+  RenderThread(const RenderThread&) = delete;
+  RenderThread& operator=(const RenderThread&) = delete;
+
+  /// Physics side: hands over the newest scene. Wait-free; never blocks.
+  void publish(FrameScene scene);
+  /// Asks for the next rendered frame to be written as PNGs: "<prefix>_left.png", "_right.png",
+  /// "_stereo.png" (side by side). Returns immediately.
+  void request_png(std::string path_prefix);
+  /// Stops rendering; returns after the thread has finished (the last published scene is rendered
+  /// first if it had not been).
+  void stop();
+
+  std::uint64_t frames_rendered() const { return frames_.load(std::memory_order_acquire); }
+  std::uint64_t scenes_dropped() const { return mailbox_.dropped(); }
+  /// Step index of the last rendered frame.
+  std::uint64_t last_step_rendered() const { return last_step_.load(std::memory_order_acquire); }
+  /// The first error raised on the render thread after start-up (rendering then stops), if any.
+  std::optional<std::string> error() const;
+  const std::string& context_description() const { return context_description_; }
+  /// Prefixes ("<dir>/step_<step>") of the PNG series written so far (png_dir).
+  std::vector<std::string> pngs_written() const;
+
+ private:
+  void run(std::promise<void>& started);
+  RenderThreadOptions options_;
+  LatestSlot<FrameScene> mailbox_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> wake_{0};  // bumped by publish()/stop(); the render thread sleeps on it
+  std::atomic<std::uint64_t> frames_{0};
+  std::atomic<std::uint64_t> last_step_{0};
+  mutable std::mutex mutex_;  // guards png_prefix_ and error_ (never taken by publish())
+  std::string png_prefix_;
+  std::optional<std::string> error_;
+  std::vector<std::string> pngs_written_;
+  std::string context_description_;
+  std::thread thread_;
+};
+
+}  // namespace vitreo::render

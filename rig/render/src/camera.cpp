@@ -1,0 +1,62 @@
+#include "vitreo/render/camera.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vitreo::render {
+
+StereoViews stereo_views(const Microscope& m, float globe_radius_mm, int width, int height) {
+  StereoViews out;
+  // The microscope looks down −z (patient supine). image_up is projected onto the image plane.
+  const Vec3 forward{0, 0, -1};
+  Vec3 up = m.image_up - forward * dot(m.image_up, forward);
+  if (length(up) < 1e-6f) up = {0, 1, 0};
+  up = normalize(up);
+  const Vec3 right = normalize(cross(forward, up));
+  out.forward = forward;
+  out.right = right;
+  out.up = up;
+
+  const float zoom = std::max(m.zoom, 1e-3f);
+  const float aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
+  float distance = 0;   // camera centre to target along the axis
+  float half_tan = 0;   // tan(half vertical field angle)
+  float base = 0;       // stereo base
+  if (m.wide_angle) {
+    // Contact-lens-like wide field: a short-distance, wide-angle view from just above the cornea,
+    // with the stereo base scaled down with the distance so the depth impression stays similar.
+    const Vec3 cam{m.target_mm.x, m.target_mm.y, m.wide_distance_mm};
+    distance = cam.z - m.target_mm.z;
+    half_tan = std::tan(0.5f * m.wide_field_deg * 3.14159265f / 180.0f) / zoom;
+    base = m.stereo_base_mm * distance / std::max(m.working_distance_mm, 1.0f);
+  } else {
+    distance = m.working_distance_mm;
+    half_tan = 0.5f * m.field_mm / zoom / distance;
+    base = m.stereo_base_mm;
+  }
+  const Vec3 centre = m.target_mm - forward * distance;
+  const float convergence = m.convergence_distance_mm > 0 ? m.convergence_distance_mm : distance;
+  const float focus = m.focus_distance_mm > 0 ? m.focus_distance_mm : distance;
+  // Depth range: the whole globe (and a margin for instruments outside it) around the target.
+  const float depth_extent = 2.0f * globe_radius_mm + 20.0f;
+  const float far_plane = distance + depth_extent;
+  const float near_plane = std::max(distance - depth_extent, 0.5f);
+
+  for (int e = 0; e < 2; ++e) {
+    const float s = (e == 0 ? -0.5f : 0.5f) * base;  // left eye at −base/2
+    EyeView& v = out.eye[e];
+    v.position_mm = centre + right * s;
+    v.view = look_at(v.position_mm, v.position_mm + forward, up);
+    const float top = near_plane * half_tan;
+    const float half_w = top * aspect;
+    const float shift = s * near_plane / convergence;  // shear so both frusta meet at `convergence`
+    v.projection = frustum(-half_w - shift, half_w - shift, -top, top, near_plane, far_plane);
+    v.view_projection = v.projection * v.view;
+    v.near_mm = near_plane;
+    v.far_mm = far_plane;
+    v.focus_distance_mm = focus;
+  }
+  return out;
+}
+
+}  // namespace vitreo::render

@@ -1,0 +1,145 @@
+#include "vitreo/render/render_thread.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <future>
+
+#include "vitreo/render/frame_ring.hpp"
+#include "vitreo/render/png_io.hpp"
+
+namespace vitreo::render {
+
+RenderThread::RenderThread(RenderThreadOptions options) : options_(std::move(options)) {
+  std::promise<void> started;
+  std::future<void> ready = started.get_future();
+  // The promise moves into the thread: this constructor may return (and its locals die) while
+  // set_value() is still finishing there.
+  thread_ = std::thread([this, p = std::move(started)]() mutable { run(p); });
+  try {
+    ready.get();  // rethrows the start-up failure
+  } catch (...) {
+    thread_.join();
+    throw;
+  }
+}
+
+RenderThread::~RenderThread() { stop(); }
+
+void RenderThread::publish(FrameScene scene) {
+  mailbox_.publish(std::move(scene));
+  // Wakes the render thread if it sleeps on wake_; a notify is a syscall at most, never a wait.
+  wake_.fetch_add(1, std::memory_order_release);
+  wake_.notify_one();
+}
+
+void RenderThread::request_png(std::string path_prefix) {
+  std::lock_guard lock(mutex_);
+  png_prefix_ = std::move(path_prefix);
+}
+
+void RenderThread::stop() {
+  if (!thread_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  wake_.fetch_add(1, std::memory_order_release);
+  wake_.notify_one();
+  thread_.join();
+}
+
+std::vector<std::string> RenderThread::pngs_written() const {
+  std::lock_guard lock(mutex_);
+  return pngs_written_;
+}
+
+namespace {
+void write_stereo_pngs(const std::string& prefix, const StereoFrame& frame) {
+  write_png(prefix + "_left.png", frame.eye(0));
+  write_png(prefix + "_right.png", frame.eye(1));
+  write_png(prefix + "_stereo.png", frame.side_by_side());
+}
+
+std::string series_prefix(const std::string& dir, std::uint64_t step) {
+  char name[48];
+  std::snprintf(name, sizeof name, "/step_%09llu", static_cast<unsigned long long>(step));
+  return dir + name;
+}
+}  // namespace
+
+std::optional<std::string> RenderThread::error() const {
+  std::lock_guard lock(mutex_);
+  return error_;
+}
+
+void RenderThread::run(std::promise<void>& started) {
+  std::unique_ptr<EglContext> context;
+  std::unique_ptr<StereoRenderer> renderer;
+  std::unique_ptr<FrameRingWriter> ring;
+  try {
+    context = std::make_unique<EglContext>(options_.egl);
+    renderer = std::make_unique<StereoRenderer>(options_.render);
+    if (!options_.shm_ring_name.empty())
+      ring = std::make_unique<FrameRingWriter>(options_.shm_ring_name, options_.render.eye_width,
+                                               options_.render.eye_height, options_.shm_ring_slots);
+    context_description_ = context->description();
+    started.set_value();
+  } catch (...) {
+    renderer.reset();
+    context.reset();
+    started.set_exception(std::current_exception());
+    return;
+  }
+  spdlog::info("render thread: {}", context_description_);
+
+  StereoFrame frame;
+  try {
+    for (;;) {
+      const std::uint64_t wake = wake_.load(std::memory_order_acquire);
+      const bool stopping = stop_.load(std::memory_order_acquire);
+      const FrameScene* scene = mailbox_.take();
+      if (scene == nullptr) {
+        if (stopping) break;
+        wake_.wait(wake, std::memory_order_acquire);  // sleeps until the next publish()/stop()
+        continue;
+      }
+      renderer->render(*scene, frame);
+      if (ring) ring->write(frame);
+      std::string prefix;
+      {
+        std::lock_guard lock(mutex_);
+        prefix.swap(png_prefix_);
+      }
+      if (!prefix.empty()) write_stereo_pngs(prefix, frame);
+      const std::uint64_t n = frames_.load(std::memory_order_relaxed) + 1;
+      if (!options_.png_dir.empty() && options_.png_every_frames > 0 && n % options_.png_every_frames == 0) {
+        const std::string p = series_prefix(options_.png_dir, frame.step_index);
+        write_stereo_pngs(p, frame);
+        std::lock_guard lock(mutex_);
+        pngs_written_.push_back(p);
+      }
+      if (options_.on_frame) options_.on_frame(frame);
+      last_step_.store(frame.step_index, std::memory_order_release);
+      frames_.fetch_add(1, std::memory_order_acq_rel);
+      frames_.notify_all();
+    }
+    // The last frame of the run, unless it was just written as one of the series.
+    if (!options_.png_dir.empty() && frames_.load(std::memory_order_relaxed) > 0) {
+      const std::string p = series_prefix(options_.png_dir, frame.step_index);
+      std::lock_guard lock(mutex_);
+      if (pngs_written_.empty() || pngs_written_.back() != p) {
+        write_stereo_pngs(p, frame);
+        pngs_written_.push_back(p);
+      }
+      spdlog::info("render thread: {} stereo frame(s) written to {} (last: {}_stereo.png)", pngs_written_.size(),
+                   options_.png_dir, pngs_written_.back());
+    }
+  } catch (const std::exception& e) {
+    spdlog::error("render thread stopped: {}", e.what());
+    std::lock_guard lock(mutex_);
+    error_ = e.what();
+  }
+  ring.reset();
+  renderer.reset();
+  context.reset();
+}
+
+}  // namespace vitreo::render

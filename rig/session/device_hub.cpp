@@ -1,0 +1,133 @@
+#include "rig/session/device_hub.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+
+#include "rig/session/device_inputs.hpp"
+#include "rig/session/simulation_model.hpp"
+
+namespace vitreo::rig {
+
+DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* status_out) : status_out_(status_out) {
+  for (auto& spec : specs) {
+    auto d = std::make_unique<Device>();
+    d->spec = spec;
+    if (!spec.sim_script.empty()) {
+      drivers::sim::Script script;
+      std::string error;
+      if (!drivers::sim::parse_script(spec.sim_script, script, &error)) {
+        throw std::runtime_error("device " + spec.name + ": bad simulation script: " + error);
+      }
+      d->sim = std::make_unique<drivers::sim::PtySimDevice>(script, spec.serial_path);
+    }
+    d->driver = std::make_unique<drivers::SerialDevice>(spec.serial_path, clock_);
+    Device* raw = d.get();
+    d->driver->session().set_on_sample([this, raw](const drivers::Sample& s) {
+      telemetry::DeviceInput in = encode_sample(s, raw->spec.device_id, raw->sequence++);
+      in.channel = raw->spec.channel;
+      raw->latest.write_slot() = in;
+      raw->latest.publish();
+    });
+    d->driver->session().set_on_state([this, raw](drivers::LinkState from, drivers::LinkState to, const char* why) {
+      spdlog::info("device {}: {} -> {} ({})", raw->spec.name, drivers::to_string(from), drivers::to_string(to), why ? why : "");
+      const bool up = to == drivers::LinkState::streaming;
+      const bool down = to == drivers::LinkState::lost;
+      if (!up && !down) return;
+      telemetry::DeviceInput link;
+      link.device_id = raw->spec.device_id;
+      link.device_kind = kLinkKind;
+      link.channel = raw->spec.channel;
+      link.host_time_us = static_cast<std::int64_t>(clock_.now_us());
+      link.sequence = raw->sequence++;
+      link.n_values = 1;
+      link.values[0] = static_cast<double>(up ? LinkInput::Up : LinkInput::Lost);
+      if (!links_.try_push(link)) spdlog::warn("device {}: link-change queue full, change dropped", raw->spec.name);
+    });
+    devices_.push_back(std::move(d));
+  }
+}
+
+DeviceHub::~DeviceHub() { stop(); }
+
+void DeviceHub::start() {
+  if (running_.exchange(true)) return;
+  sim_thread_ = std::thread([this] { run_sims(); });
+  driver_thread_ = std::thread([this] { run_drivers(); });
+}
+
+void DeviceHub::stop() {
+  if (!running_.exchange(false)) return;
+  if (sim_thread_.joinable()) sim_thread_.join();
+  if (driver_thread_.joinable()) driver_thread_.join();
+}
+
+void DeviceHub::unplug(std::size_t device) { devices_.at(device)->plug_request.store(-1); }
+void DeviceHub::plug(std::size_t device) { devices_.at(device)->plug_request.store(+1); }
+
+void DeviceHub::run_sims() {
+  // The emulators stand in for the devices' own firmware: they run on their own thread, in real
+  // time, and the drivers know nothing about them beyond the bytes on the pty.
+  while (running_.load(std::memory_order_acquire)) {
+    const std::uint64_t now = clock_.now_us();
+    for (auto& d : devices_) {
+      if (!d->sim) continue;
+      const int request = d->plug_request.exchange(0);
+      if (request < 0) d->sim->unplug();
+      if (request > 0) d->sim->plug();
+      d->sim->step(now);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(250));
+  }
+}
+
+void DeviceHub::run_drivers() {
+  std::uint64_t next_status = 0;
+  while (running_.load(std::memory_order_acquire)) {
+    for (auto& d : devices_) d->driver->poll(0);
+    const std::uint64_t now = clock_.now_us();
+    if (now >= next_status) {
+      publish_status(now);
+      next_status = now + 100'000;  // 10 Hz (rig/telemetry/CHANNELS.md)
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+namespace {
+// device_status_t's lifecycle codes (after ros2_control: inactive while connecting, active when
+// streaming, error when stale, lost when gone).
+std::int8_t status_code(drivers::LinkState s) {
+  switch (s) {
+    case drivers::LinkState::streaming: return 2;
+    case drivers::LinkState::stale: return 3;
+    case drivers::LinkState::lost: return 4;
+    default: return 1;
+  }
+}
+}  // namespace
+
+void DeviceHub::publish_status(std::uint64_t) {
+  if (!status_out_) return;
+  for (const auto& d : devices_) {
+    const auto& session = d->driver->session();
+    const auto& st = session.stats();
+    telemetry::DeviceStatus s;
+    s.device_id = d->spec.device_id;
+    std::strncpy(s.name, d->spec.name.c_str(), sizeof s.name - 1);
+    std::strncpy(s.transport, ("serial:" + d->spec.serial_path).c_str(), sizeof s.transport - 1);
+    s.state = status_code(session.state());
+    std::strncpy(s.detail, drivers::to_string(session.state()), sizeof s.detail - 1);
+    s.frames_rx = static_cast<std::int64_t>(st.frames);
+    s.bytes_rx = static_cast<std::int64_t>(st.bytes);
+    s.crc_errors = static_cast<std::int64_t>(st.crc_errors);
+    s.framing_errors = static_cast<std::int64_t>(st.framing_errors);
+    s.sequence_gaps = static_cast<std::int64_t>(st.drops);
+    s.reconnects = static_cast<std::int64_t>(st.reconnects);
+    status_out_->push(s);
+  }
+}
+
+}  // namespace vitreo::rig

@@ -1,0 +1,91 @@
+#pragma once
+// The rig's devices on their own threads: drivers turn bytes into samples, samples into the
+// recorded input form, and hand them to physics through wait-free mailboxes — the newest sample per
+// device (a late physics step takes the latest, never a queue of stale ones) and a small ring of
+// link changes (each one must reach physics exactly once, to be recorded and replayed).
+//
+// In simulation mode the hub also runs firmware emulators behind ptys, so the drivers talk to the
+// same bytes over the same kind of link as on the rig (drivers/sim).
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "drivers/serial.hpp"
+#include "drivers/sim/pty_sim.hpp"
+#include "rig/runtime/spsc_ring.hpp"
+#include "rig/runtime/triple_buffer.hpp"
+#include "rig/telemetry/publisher.hpp"
+#include "rig/telemetry/recording.hpp"
+
+namespace vitreo::rig {
+
+struct DeviceSpec {
+  std::string name;         // "tracker-0", "pedals", "eyeball"
+  std::string serial_path;  // the device's tty (or the simulator's link path)
+  std::int32_t device_id = 0;
+  int channel = 0;          // for trackers: the instrument it carries
+  // Simulation mode: the emulator's script (drivers/sim/emulator.hpp); empty = a real device.
+  std::string sim_script;
+};
+
+class DeviceHub {
+ public:
+  explicit DeviceHub(std::vector<DeviceSpec> devices, telemetry::TelemetrySource* status_out = nullptr);
+  ~DeviceHub();
+  DeviceHub(const DeviceHub&) = delete;
+  DeviceHub& operator=(const DeviceHub&) = delete;
+
+  void start();
+  void stop();
+
+  // Physics side (one consumer thread), wait-free: visits each device's newest sample if it is new
+  // since the last call, and every link change since the last call.
+  template <class F>
+  void take_new(F&& f) {
+    telemetry::DeviceInput link;
+    while (links_.try_pop(link)) f(link);
+    for (auto& d : devices_) {
+      if (!d->latest.update()) continue;
+      const telemetry::DeviceInput& in = d->latest.read_slot();
+      if (in.sequence == d->last_taken) continue;
+      d->last_taken = in.sequence;
+      f(in);
+    }
+  }
+
+  std::size_t device_count() const { return devices_.size(); }
+  // Cable pull / re-plug of a simulated device (tests, demonstrations). Thread-safe.
+  void unplug(std::size_t device);
+  void plug(std::size_t device);
+  // Link statistics (driver thread's view; copied under no lock, for summaries after stop()).
+  const drivers::LinkStats& stats(std::size_t device) const { return devices_[device]->driver->session().stats(); }
+  const std::string& name(std::size_t device) const { return devices_[device]->spec.name; }
+  std::uint64_t link_events_dropped() const { return links_.dropped(); }
+
+ private:
+  struct Device {
+    DeviceSpec spec;
+    std::unique_ptr<drivers::sim::PtySimDevice> sim;
+    std::unique_ptr<drivers::SerialDevice> driver;
+    runtime::TripleBuffer<telemetry::DeviceInput> latest;
+    std::int64_t sequence = 0;
+    std::int64_t last_taken = -1;
+    std::atomic<int> plug_request{0};  // +1 plug, -1 unplug
+    drivers::LinkState last_state = drivers::LinkState::lost;
+  };
+  void run_sims();
+  void run_drivers();
+  void publish_status(std::uint64_t now_us);
+
+  std::vector<std::unique_ptr<Device>> devices_;
+  runtime::SpscRing<telemetry::DeviceInput> links_{256};
+  telemetry::TelemetrySource* status_out_;
+  drivers::SteadyClock clock_;
+  std::atomic<bool> running_{false};
+  std::thread sim_thread_, driver_thread_;
+};
+
+}  // namespace vitreo::rig

@@ -1,0 +1,259 @@
+#include "rig/session/rig_session.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <algorithm>
+#include <memory>
+#include <optional>
+
+#include "rig/runtime/clock.hpp"
+#include "rig/runtime/thread_harness.hpp"
+#include "rig/telemetry/commands.hpp"
+#include "rig/telemetry/publisher.hpp"
+#include "rig/telemetry/recording.hpp"
+#include "rig/session/frame_source.hpp"
+#include "vitreo/render/render_thread.hpp"
+
+namespace vitreo::rig {
+
+namespace {
+
+telemetry::Event to_event(const core::TissueEvent& e, std::int64_t step, double t_s) {
+  telemetry::Event ev;
+  ev.step = step;
+  ev.t_s = t_s;
+  ev.kind = e.kind == core::TissueEventKind::kTear ? telemetry::EventKind::Tear : telemetry::EventKind::AttachmentBroken;
+  ev.tissue_id = static_cast<std::int32_t>(e.surface);
+  for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
+  ev.magnitude = e.magnitude;
+  return ev;
+}
+
+telemetry::InstrumentState to_state(const InstrumentSlot& slot, int id, std::int64_t step, double t_s) {
+  telemetry::InstrumentState st;
+  st.step = step;
+  st.t_s = t_s;
+  st.instrument_id = static_cast<std::int8_t>(id);
+  st.port_id = static_cast<std::int8_t>(slot.port);
+  std::snprintf(st.kind, sizeof st.kind, "tool-%d", slot.tool_type);
+  for (int i = 0; i < 3; ++i) {
+    st.tip_mm[i] = slot.pose.tip_mm[i];
+    st.shaft_axis[i] = slot.pose.axis[i];
+  }
+  st.roll_rad = slot.pose.roll_rad;
+  st.insertion_mm = slot.pose.insertion_mm;
+  st.actuation = slot.pose.actuation;
+  st.frozen = slot.frozen;
+  return st;
+}
+
+// Recorded at the last step so a replay knows how long the session ran.
+telemetry::DeviceInput session_end_marker(std::uint64_t steps) {
+  telemetry::DeviceInput in;
+  in.device_kind = kSessionEndKind;
+  in.n_values = 1;
+  in.values[0] = static_cast<double>(steps);
+  return in;
+}
+
+telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
+  telemetry::DeviceInput in;
+  in.device_kind = kCommandKind;
+  in.sequence = cmd.seq;
+  in.n_values = 2;
+  in.values[0] = static_cast<double>(static_cast<int>(cmd.code));
+  in.values[1] = cmd.value;
+  return in;
+}
+
+}  // namespace
+
+SessionSummary run_session(const SessionConfig& config) {
+  SimulationModel model(config.model);
+  telemetry::TelemetryPublisher publisher(telemetry::PublisherConfig{config.lcm_url, 4096});
+  telemetry::TelemetrySource& physics_out = publisher.add_source("physics");
+  telemetry::TelemetrySource& devices_out = publisher.add_source("devices");
+  telemetry::CommandServer commands(publisher.lcm());
+
+  std::unique_ptr<telemetry::Recorder> recorder;
+  if (!config.record_path.empty()) {
+    telemetry::RecordingHeader header;
+    header.case_id = config.case_id;
+    header.config_name = "vitreo";
+    header.config_text = config.config_text;
+    header.step_period_us = static_cast<std::int32_t>(config.model.dt_s * 1e6);
+    recorder = std::make_unique<telemetry::Recorder>(config.record_path, header);
+  }
+
+  // Rendering: created first so an EGL failure stops the session before any device starts.
+  std::unique_ptr<render::RenderThread> renderer;
+  runtime::TripleBuffer<ViewSnapshot> views;
+  std::optional<FrameBuilder> frames;
+  if (config.render) {
+    render::RenderThreadOptions ro;
+    ro.render.eye_width = config.eye_width;
+    ro.render.eye_height = config.eye_height;
+    ro.png_dir = config.png_dir;
+    ro.png_every_frames = config.png_every_frames;
+    renderer = std::make_unique<render::RenderThread>(ro);
+    reserve_view_snapshots(model, views);
+    frames.emplace(config.model.scene.globe_radius_mm, config.model.ports);
+  }
+  const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));
+
+  DeviceHub hub(config.devices, &devices_out);
+  SessionSummary summary;
+  runtime::SteadyClock wall;
+  runtime::HarnessConfig harness_config;
+  harness_config.loop.period_ns = static_cast<std::int64_t>(config.model.dt_s * 1e9);
+  harness_config.max_steps = config.steps;
+  harness_config.physics_realtime = config.realtime;
+  const runtime::FixedStepLoop* loop = nullptr;  // the harness's loop; set before start()
+
+  runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
+    const auto step = static_cast<std::int64_t>(k);
+    if (config.on_step) config.on_step(k, hub);
+    auto consume = [&](const telemetry::DeviceInput& in) {
+      telemetry::DeviceInput stamped = in;
+      stamped.step = step;
+      if (recorder) recorder->push(stamped);
+      model.apply(stamped);
+    };
+    telemetry::AcceptedCommand cmd;
+    while (commands.poll(cmd)) consume(command_input(cmd));
+    // What the command server validates the next commands against (one case for now).
+    telemetry::CommandContext& context = commands.context().write_slot();
+    context.paused = model.paused();
+    context.case_index = 0;
+    context.case_count = 1;
+    commands.context().publish();
+    hub.take_new(consume);
+    if (k + 1 == config.steps) consume(session_end_marker(config.steps));
+    const core::StepReport report = model.step();
+    for (const auto& slot : model.instruments()) {
+      if (slot.frozen) {
+        ++summary.frozen_steps;
+        break;
+      }
+    }
+    summary.tears += report.tears;
+    summary.attachments_broken += report.attachments_broken;
+    if (!report.ok) ++summary.rolled_back;
+    for (const auto& e : model.world().events()) {
+      if (e.kind != core::TissueEventKind::kRolledBack) physics_out.push(to_event(e, step, t_s));
+    }
+    if (k % 4 == 0) {  // instrument state at 250 Hz (CHANNELS.md)
+      const auto& slots = model.instruments();
+      for (std::size_t i = 0; i < slots.size(); ++i) {
+        if (slots[i].present) physics_out.push(to_state(slots[i], static_cast<int>(i), step, t_s));
+      }
+    }
+    if (renderer && (k % view_every == 0 || k + 1 == config.steps)) {
+      capture_view(model, k, t_s, views.write_slot());
+      views.publish();
+    }
+    if (loop && (k + 1) % 250 == 0) {  // physics timing at 4 Hz, cumulative over the session
+      telemetry::PhysicsTiming t = telemetry::timing_item(loop->stats(), k, harness_config.loop.period_ns);
+      t.paused = model.paused();
+      physics_out.push(t);
+    }
+  });
+  loop = &harness.loop();
+  harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
+    publisher.pump();
+    publisher.handle_incoming();
+  });
+  if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
+  std::uint64_t last_view = ~std::uint64_t{0};
+  auto render_latest = [&] {
+    if (!views.update()) return;
+    const ViewSnapshot& v = views.read_slot();
+    if (v.step == last_view) return;
+    last_view = v.step;
+    renderer->publish(frames->build(v));
+  };
+  if (renderer) {
+    harness.add_service("render", std::chrono::milliseconds(static_cast<int>(1000.0 / config.display_hz)), render_latest);
+  }
+
+  hub.start();
+  harness.start();
+  harness.wait_physics();
+  harness.stop();
+  hub.stop();
+  if (recorder) recorder->close();
+  publisher.pump();
+  if (renderer) {
+    render_latest();  // the final state, so the last frame shows where the session ended
+    renderer->stop();
+    summary.frames_rendered = renderer->frames_rendered();
+    summary.scenes_dropped = renderer->scenes_dropped();
+    summary.pngs = renderer->pngs_written();
+    summary.renderer = renderer->context_description();
+    if (auto err = renderer->error()) throw std::runtime_error("rendering failed: " + *err);
+  }
+
+  summary.steps = harness.loop().stats().steps;
+  summary.simulated_s = static_cast<double>(summary.steps) * config.model.dt_s;
+  summary.loop = harness.loop().stats();
+  summary.inputs_applied = model.inputs_applied();
+  summary.inputs_refused = model.inputs_refused();
+  if (recorder) {
+    summary.inputs_recorded = recorder->written();
+    summary.recorder_dropped = recorder->dropped();
+  }
+  summary.telemetry_published = publisher.published();
+  summary.telemetry_dropped = publisher.dropped();
+  summary.state_hash = model.state_hash();
+  for (std::size_t i = 0; i < hub.device_count(); ++i) {
+    const auto& st = hub.stats(i);
+    char line[256];
+    std::snprintf(line, sizeof line, "%-10s frames %llu, valid %llu, CRC errors %llu, samples %llu, reconnects %llu",
+                  hub.name(i).c_str(), static_cast<unsigned long long>(st.frames),
+                  static_cast<unsigned long long>(st.valid), static_cast<unsigned long long>(st.crc_errors),
+                  static_cast<unsigned long long>(st.samples_delivered), static_cast<unsigned long long>(st.reconnects));
+    summary.device_lines.emplace_back(line);
+  }
+  return summary;
+}
+
+ReplaySummary replay_session(const std::string& path, const ModelConfig& model_config, bool real_time) {
+  const telemetry::Recording rec = telemetry::read_recording(path);
+  SimulationModel model(model_config);
+  telemetry::InputCursor cursor(rec);
+  std::uint64_t steps = 0;
+  std::uint64_t inputs = 0;
+  // The session's last step is the last one that consumed an input, or later: replay as many steps
+  // as the header's duration says when present, else through the last input.
+  std::uint64_t total = rec.inputs.empty() ? 0 : static_cast<std::uint64_t>(rec.inputs.back().step) + 1;
+  for (const auto& in : rec.inputs) {
+    if (in.device_kind == kSessionEndKind && in.n_values >= 1) total = static_cast<std::uint64_t>(in.values[0]);
+  }
+  runtime::SimulatedClock sim;
+  runtime::SteadyClock wall;
+  runtime::Clock& clock = real_time ? static_cast<runtime::Clock&>(wall) : static_cast<runtime::Clock&>(sim);
+  runtime::LoopConfig loop_config;
+  loop_config.period_ns = rec.header.step_period_us * 1000LL;
+  runtime::FixedStepLoop loop(clock, loop_config, [&](std::uint64_t k, double) {
+    cursor.feed_through_step(static_cast<std::int64_t>(k), [&](const telemetry::DeviceInput& in) {
+      model.apply(in);
+      ++inputs;
+    });
+    model.step();
+    ++steps;
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  loop.run(total);
+  ReplaySummary out;
+  out.steps = steps;
+  out.inputs = inputs;
+  out.state_hash = model.state_hash();
+  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.case_id = rec.header.case_id;
+  return out;
+}
+
+}  // namespace vitreo::rig

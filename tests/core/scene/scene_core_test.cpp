@@ -1,0 +1,209 @@
+// Eye model dimensions, fundus textures, scene building (tears, membranes, gel) and snapshots.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "core/anatomy/eye_model.hpp"
+#include "core/anatomy/fundus_texture.hpp"
+#include "core/scene/scene_builder.hpp"
+#include "core/scene/snapshot.hpp"
+#include "core/tissue/surface_validity.hpp"
+
+namespace vitreo::core {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+EyeParameters small_eye() {
+  EyeParameters p;
+  p.retina_vertices = 3000;
+  return p;
+}
+
+TEST(EyeModel, DimensionsMatchParameters) {
+  for (double axial : {22.0, 24.0, 26.5}) {
+    EyeParameters p = small_eye();
+    p.axial_length_mm = axial;
+    const EyeModel eye = build_eye_model(p);
+    const RenderMesh* sclera = eye.find_static("sclera");
+    const RenderMesh* cornea = eye.find_static("cornea");
+    ASSERT_NE(sclera, nullptr);
+    ASSERT_NE(cornea, nullptr);
+    double zmin = 1e9, zmax = -1e9, rho_max = 0.0;
+    for (const auto& q : sclera->mesh.positions) {
+      zmin = std::min(zmin, q.z());
+      rho_max = std::max(rho_max, std::hypot(q.x(), q.y()));
+    }
+    for (const auto& q : cornea->mesh.positions) zmax = std::max(zmax, q.z());
+    EXPECT_NEAR(zmax - zmin, axial, 0.05) << "axial length";
+    EXPECT_NEAR(2.0 * rho_max, p.globe_diameter_mm, 0.1) << "globe diameter";
+    // The wall is the sclera moved in by sclera + choroid.
+    EXPECT_NEAR(eye.wall.radius_toward(Vec3(0, 0, -1)), 0.5 * axial - p.sclera_thickness_mm - p.choroid_thickness_mm, 0.02);
+    // Retina on the wall, count near the parameter.
+    EXPECT_NEAR(static_cast<double>(eye.retina_mesh.vertex_count()), p.retina_vertices, 0.15 * p.retina_vertices);
+    for (const auto& q : eye.retina_mesh.positions) ASSERT_NEAR(eye.wall.clearance(q), 0.0, 0.02);
+    // Optic disc nasal (+x) at the given angle from the posterior pole; fovea at the pole.
+    EXPECT_NEAR(std::atan2(eye.optic_disc_mm.x(), -eye.optic_disc_mm.z()) / kDeg, p.optic_disc_offset_deg, 0.2);
+    EXPECT_GT(eye.optic_disc_mm.x(), 0.0);
+    EXPECT_NEAR(eye.fovea_mm.x(), 0.0, 1e-9);
+    // Ports ~ports_mm behind the limbus (chord ≈ arc over such a short distance).
+    ASSERT_EQ(eye.ports.size(), 3u);
+    for (const auto& port : eye.ports) {
+      const double rho = std::hypot(port.outer_mm.x(), port.outer_mm.y());
+      const double d = std::hypot(rho - eye.limbus_radius_mm, port.outer_mm.z() - eye.limbus_z_mm);
+      EXPECT_NEAR(d, p.ports_mm, 0.15) << port.name;
+      EXPECT_NEAR(port.axis.norm(), 1.0, 1e-12);
+    }
+    // Ora serrata behind the ports, in front of the equator.
+    EXPECT_GT(eye.ora_polar_rad, 90.0 * kDeg);
+    const RenderMesh* cp = eye.find_static("ciliary_processes");
+    ASSERT_NE(cp, nullptr);
+    EXPECT_EQ(cp->mesh.vertex_count(), 40u * 6u);
+    for (const char* name : {"sclera", "choroid", "cornea", "iris", "lens", "ciliary_processes"}) {
+      const RenderMesh* m = eye.find_static(name);
+      ASSERT_NE(m, nullptr) << name;
+      EXPECT_EQ(m->uv.size(), m->mesh.vertex_count()) << name;
+    }
+  }
+}
+
+TEST(EyeModel, RefusesBadParameters) {
+  EyeParameters p = small_eye();
+  p.axial_length_mm = std::nan("");
+  EXPECT_THROW(build_eye_model(p), InvalidArgument);
+  p = small_eye();
+  p.ports_mm = 7.0;
+  EXPECT_THROW(build_eye_model(p), InvalidArgument);
+}
+
+TEST(FundusTexture, DeterministicPerSeedAndVesselsAvoidTheFovea) {
+  const EyeModel eye = build_eye_model(small_eye());
+  const FundusTextures a = generate_fundus(eye, {7, 256});
+  const FundusTextures b = generate_fundus(eye, {7, 256});
+  const FundusTextures c = generate_fundus(eye, {8, 256});
+  EXPECT_EQ(a.retina.rgba, b.retina.rgba);
+  EXPECT_EQ(a.choroid.rgba, b.choroid.rgba);
+  EXPECT_NE(a.retina.rgba, c.retina.rgba);
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const FundusTextures t = generate_fundus(eye, {seed, 128});
+    EXPECT_GT(t.vessels.size(), 200u) << "seed " << seed;
+    int deep = 0;
+    for (const auto& s : t.vessels) {
+      ASSERT_GE(distance_to_segment(Vec2::Zero(), s.a_mm, s.b_mm) - 0.5 * s.width_mm, eye.parameters.fovea_radius_mm)
+          << "seed " << seed;
+      deep = std::max(deep, s.depth);
+    }
+    EXPECT_GE(deep, 2) << "branching";
+  }
+  // No vessel-coloured pixel inside the fovea.
+  const double mm_per_px = 2.0 * eye.fundus_extent_mm / a.retina.width;
+  for (int y = 0; y < a.retina.height; ++y) {
+    for (int x = 0; x < a.retina.width; ++x) {
+      const Vec2 p((x + 0.5) * mm_per_px - eye.fundus_extent_mm, (y + 0.5) * mm_per_px - eye.fundus_extent_mm);
+      if (p.norm() > eye.parameters.fovea_radius_mm - mm_per_px) continue;
+      const std::uint8_t* px = a.retina.pixel(x, y);
+      EXPECT_FALSE(px[3] > 150 && px[1] < 60) << "vessel pixel in the fovea at " << x << "," << y;
+    }
+  }
+}
+
+SceneDescription busy_scene() {
+  SceneDescription d;
+  d.name = "busy";
+  d.anatomy = small_eye();
+  d.anatomy.retina_vertices = 6000;
+  d.texture_size_px = 128;
+  d.materials = default_materials();
+  d.tears.push_back({"u", {70.0, 120.0}, 2.5, 3.5, 0.8});
+  d.detachments.push_back({"fluid", {65.0, 120.0}, 25.0, 150.0});
+  MembraneSpec erm;
+  erm.name = "erm";
+  erm.center = {8.0, 0.0};
+  erm.size_mm = 3.0;
+  d.membranes.push_back(erm);
+  MembraneSpec perp;
+  perp.name = "plane";
+  perp.kind = MembraneKind::kPerpendicular;
+  perp.center = {40.0, 270.0};
+  perp.rest_length_scale = 0.8;
+  d.membranes.push_back(perp);
+  d.settle.max_steps = 200;
+  return d;
+}
+
+TEST(SceneBuilder, BuildsTearsMembranesGelAndSettles) {
+  const Scene s = build_scene(busy_scene());
+  ASSERT_EQ(s.tears.size(), 1u);
+  EXPECT_GE(s.tears[0].cut_vertices, 5u);
+  EXPECT_GT(s.tears[0].flap_vertices.size(), 10u);
+  EXPECT_NE(s.gel, kNone);
+  EXPECT_GT(s.gel_attachments, 50u);
+  ASSERT_EQ(s.membranes.size(), 2u);
+  EXPECT_GT(s.membranes[0].strong_attachments, 0u);
+  EXPECT_LT(s.membranes[0].strong_attachments, s.membranes[0].attachment_count);
+  EXPECT_TRUE(s.settle.ok);
+  for (std::uint32_t i = 0; i < s.world.surface_count(); ++i) {
+    const auto r = check_surface(s.world.surface(i));
+    EXPECT_TRUE(r.ok()) << i << ": " << r.summary();
+  }
+  EXPECT_EQ(s.world.step_count(), 0u);
+  // The flap stands off the wall (3-D tear), and the detachment lifts the retina.
+  EXPECT_GT(max_retina_lift_mm(s), 0.5);
+}
+
+TEST(SceneBuilder, SameDescriptionSameHash) {
+  const Scene a = build_scene(busy_scene());
+  const Scene b = build_scene(busy_scene());
+  EXPECT_EQ(a.world.state_hash(), b.world.state_hash());
+}
+
+TEST(Snapshot, SaveLoadIsExactAndStepsOnIdentically) {
+  Scene a = build_scene(busy_scene());
+  for (int i = 0; i < 30; ++i) ASSERT_TRUE(a.world.step(1e-3).ok);
+  const std::string path = ::testing::TempDir() + "/vitreo_snapshot_test.snap";
+  ASSERT_TRUE(save_snapshot(a.world, "busy", path).is_ok());
+  BuildOptions no_settle;
+  no_settle.settle = false;
+  no_settle.textures = false;
+  Scene b = build_scene(busy_scene(), no_settle);
+  EXPECT_NE(a.world.state_hash(), b.world.state_hash());
+  SnapshotInfo info;
+  const Status st = load_snapshot(b.world, path, &info);
+  ASSERT_TRUE(st.is_ok()) << st.message();
+  EXPECT_EQ(info.scene_name, "busy");
+  EXPECT_EQ(a.world.state_hash(), b.world.state_hash());
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_TRUE(a.world.step(1e-3).ok);
+    ASSERT_TRUE(b.world.step(1e-3).ok);
+  }
+  EXPECT_EQ(a.world.state_hash(), b.world.state_hash());
+  std::remove(path.c_str());
+}
+
+TEST(Snapshot, CorruptOrForeignSnapshotsAreRefusedWithoutChange) {
+  Scene a = build_scene(busy_scene(), {false, false});
+  const auto bytes = encode_snapshot(a.world, "busy");
+  const auto before = a.world.state_hash();
+  auto flipped = bytes;
+  flipped[flipped.size() / 2] ^= 0x40;
+  EXPECT_FALSE(decode_snapshot(a.world, flipped).is_ok());
+  for (std::size_t cut : {std::size_t{0}, std::size_t{7}, std::size_t{31}, bytes.size() / 3, bytes.size() - 1}) {
+    EXPECT_FALSE(decode_snapshot(a.world, std::span<const std::uint8_t>(bytes.data(), cut)).is_ok()) << cut;
+  }
+  auto bad_version = bytes;
+  bad_version[8] = 99;
+  EXPECT_FALSE(decode_snapshot(a.world, bad_version).is_ok());
+  EXPECT_EQ(a.world.state_hash(), before);
+  // A snapshot of another scene does not fit.
+  SceneDescription other = busy_scene();
+  other.membranes.clear();
+  Scene o = build_scene(other, {false, false});
+  EXPECT_FALSE(decode_snapshot(o.world, bytes).is_ok());
+  EXPECT_FALSE(load_snapshot(a.world, "/nonexistent/x.snap").is_ok());
+}
+
+}  // namespace
+}  // namespace vitreo::core

@@ -1,0 +1,175 @@
+// Vitrector removal (clipped at the removal hemisphere, exact mass, gated by the cut rate),
+// attraction, and tearing that starts at the most strained spring.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/tissue/surface_validity.hpp"
+#include "core/tissue/tissue_world.hpp"
+#include "core/topology/tear.hpp"
+#include "core/topology/vitrector.hpp"
+#include "topology_test_util.hpp"
+
+using namespace vitreo::core;
+using namespace vitreo::core::test;
+
+namespace {
+constexpr double kW = 4.0, kH = 3.0;
+constexpr int kCols = 16, kRows = 12;
+constexpr double kCell = kW / kCols;
+}  // namespace
+
+TEST(Vitrector, RemovesWhatEntersTheRemovalHemisphereClippedAtItsBoundary) {
+  Surface s(sheet(kW, kH, kCols, kRows, 0.3, 21));
+  const double mass0 = s.total_mass(), area0 = s.total_rest_area();
+  VitrectorSettings vs;
+  vs.removal_radius_mm = 0.6;
+  Vitrector vit(s, vs);
+  // Port 0.2 mm above the sheet, sucking down: the sheet inside a disc of radius √(0.6² − 0.2²).
+  const Vec3 port(2.03, 1.47, 0.2);
+  ASSERT_TRUE(vit.set_pose(port, Vec3(0, 0, -1)));
+  const auto r = vit.cut_now();
+  ASSERT_TRUE(r.status) << r.status.message();
+  EXPECT_TRUE(r.cut);
+  EXPECT_GT(r.triangles_removed, 10u);
+  const double disc = std::numbers::pi * (0.6 * 0.6 - 0.2 * 0.2);
+  // Clipped at the sphere: the removed area is the disc up to the inscribed polygon's deficit.
+  EXPECT_NEAR(r.removed_area_mm2, disc, 0.06 * disc);
+  EXPECT_NEAR(s.total_rest_area(), area0 - r.removed_area_mm2, 1e-12 * area0);
+  EXPECT_NEAR(s.total_mass(), mass0 - r.removed_mass_g, 1e-12 * mass0);
+  EXPECT_NEAR(r.removed_mass_g, s.material().areal_density_g_per_mm2() * r.removed_area_mm2, 1e-12 * mass0);
+  const auto report = check_surface(s, ValidityLimits{});
+  EXPECT_TRUE(report.ok()) << report.summary();
+  // Nothing remains inside; the new boundary lies on the clip circle within the snap tolerance.
+  const double rho = std::sqrt(0.6 * 0.6 - 0.2 * 0.2);
+  for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+    if (!s.triangle_alive(t)) continue;
+    const auto tv = s.triangle_vertices(t);
+    const Vec3 c = (s.position(tv[0]) + s.position(tv[1]) + s.position(tv[2])) / 3.0;
+    EXPECT_GT((c - port).norm(), 0.6 - 1e-9);
+  }
+  for (const auto& seg : new_boundary(s, kW, kH)) {
+    const double ra = (seg.a - Vec3(port.x(), port.y(), 0)).norm();
+    EXPECT_NEAR(ra, rho, 0.05 * 1.6 * std::sqrt(2.0) * kCell + 1e-9);
+  }
+}
+
+TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
+  SurfaceDescription d = sheet(kW, kH, kCols, kRows);
+  Environment env;
+  env.apply_pressure = false;
+  env.gravity_mm_s2 = Vec3::Zero();
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 1e6), env);
+  const auto si = world.add_surface(d);
+  Surface& s = world.surface(si);
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+    const Vec3 p = s.rest_position(v);
+    if (p.x() == 0.0 || p.x() == kW) {
+      ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+    }
+  }
+  VitrectorSettings vs;
+  Vitrector vit(s, vs);
+  const Vec3 port(2.0, 1.5, 0.3);
+  ASSERT_TRUE(vit.set_pose(port, Vec3(0, 0, -1)));
+  ASSERT_TRUE(vit.set_vacuum(400.0));
+  ASSERT_TRUE(vit.set_cut_rate(0.0));
+  const double mass0 = s.total_mass();
+  // Suction only: tissue under the port rises toward it, nothing is removed.
+  const std::uint32_t centre = 6 * (kCols + 1) + 8;
+  for (int i = 0; i < 200; ++i) {
+    const auto r = vit.apply(1e-3);
+    ASSERT_TRUE(r.status) << r.status.message();
+    ASSERT_FALSE(r.cut);
+    ASSERT_TRUE(world.step(1e-3).ok);
+  }
+  EXPECT_GT(s.position(centre).z(), 0.02) << "suction must lift the tissue toward the port";
+  EXPECT_LT(s.position(centre).z(), 0.3 + 1e-6);
+  EXPECT_EQ(s.total_mass(), mass0);
+  // 6000 cuts per minute at 1 ms steps: one cut every 10 steps; removal until the hole is made.
+  ASSERT_TRUE(vit.set_cut_rate(6000.0));
+  int cuts = 0;
+  double removed = 0.0;
+  for (int i = 0; i < 400; ++i) {
+    const auto r = vit.apply(1e-3);
+    ASSERT_TRUE(r.status) << r.status.message();
+    cuts += r.cut ? 1 : 0;
+    removed += r.removed_mass_g;
+    ASSERT_TRUE(world.step(1e-3).ok);
+    if (r.cut) {
+      const auto report = check_surface(s);
+      ASSERT_TRUE(report.ok()) << report.summary();
+    }
+  }
+  EXPECT_NEAR(cuts, 40, 1);
+  EXPECT_GT(removed, 0.0);
+  EXPECT_NEAR(s.total_mass(), mass0 - removed, 1e-12 * mass0);
+  EXPECT_NEAR(vit.total_removed_mass_g(), removed, 1e-15);
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+    if (!s.vertex_alive(v)) continue;
+    ASSERT_TRUE(std::isfinite(s.position(v).norm()));
+    EXPECT_LT(s.velocity(v).norm(), 1e3) << "small pieces must not explode";
+  }
+}
+
+TEST(Vitrector, InvalidRequestsAreRefused) {
+  Surface s(sheet(kW, kH, kCols, kRows));
+  Vitrector vit(s);
+  EXPECT_FALSE(vit.apply(1e-3).status) << "no pose yet";
+  EXPECT_FALSE(vit.set_pose(Vec3(std::nan(""), 0, 0), Vec3::UnitZ()));
+  EXPECT_FALSE(vit.set_pose(Vec3::Zero(), Vec3::Zero()));
+  EXPECT_FALSE(vit.set_vacuum(-1.0));
+  EXPECT_FALSE(vit.set_vacuum(1e4));
+  EXPECT_FALSE(vit.set_cut_rate(std::nan("")));
+  ASSERT_TRUE(vit.set_pose(Vec3(1, 1, 1), Vec3(0, 0, -1)));
+  EXPECT_FALSE(vit.apply(0.0).status);
+  EXPECT_FALSE(vit.apply(INFINITY).status);
+}
+
+TEST(Tear, ACrackOpensAtTheStrainedSpringAndEndsInsideTheAdjacentTriangles) {
+  Surface s(sheet(kW, kH, kCols, kRows));
+  const double mass0 = s.total_mass();
+  const std::uint32_t a = 6 * (kCols + 1) + 8, b = a + 1;
+  const std::uint32_t e = s.find_edge(a, b);
+  ASSERT_NE(e, kNone);
+  const Vec3 mid = 0.5 * (s.position(a) + s.position(b));
+  const EdgeId id = s.edge_id(e);
+  const auto r = tear_spring(s, id);
+  ASSERT_TRUE(r.status) << r.status.message();
+  EXPECT_EQ(r.vertices_added, 4u) << "split point, its copy, and two crack tips";
+  const auto report = check_surface(s, ValidityLimits{});
+  EXPECT_TRUE(report.ok()) << report.summary();
+  EXPECT_NEAR(s.total_mass(), mass0, 1e-12 * mass0);
+  EXPECT_LT(max_rest_vector_error(s), 1e-12);
+  // The new boundary: from the split point half way to each opposite vertex, no farther.
+  const auto boundary = new_boundary(s, kW, kH);
+  ASSERT_EQ(boundary.size(), 4u);
+  for (const auto& seg : boundary) {
+    // Half way to an opposite vertex of the (right-angled) cells: at most half the cell diagonal.
+    EXPECT_LE((seg.a - mid).norm(), 0.5 * std::sqrt(1.25) * kCell + 1e-9);
+    EXPECT_LE((seg.b - mid).norm(), 0.5 * std::sqrt(1.25) * kCell + 1e-9);
+  }
+  EXPECT_FALSE(tear_spring(s, id).status) << "the torn spring's handle is stale";
+}
+
+TEST(Tear, PropagatesFromTheMostStrainedSpringWhereThePullIs) {
+  Surface s(sheet(kW, kH, kCols, kRows));
+  // Pull a column of vertices near the middle sideways: the springs next to them strain most.
+  const std::uint32_t pulled = 6 * (kCols + 1) + 8;
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+    const Vec3 p = s.rest_position(v);
+    if (p.x() > 2.0 + 1e-9) {
+      ASSERT_TRUE(s.set_position(s.vertex_id(v), p + Vec3(0.05, 0.0, 0.0)));
+    }
+  }
+  ASSERT_TRUE(s.set_position(s.vertex_id(pulled), s.rest_position(pulled) + Vec3(0.0, 0.0, 0.2)));
+  const auto torn = propagate_tears(s, 0.15, 5);
+  EXPECT_GE(torn, 1u);
+  const auto report = check_surface(s);
+  EXPECT_TRUE(report.ok()) << report.summary();
+  // The first tear is at the pulled vertex.
+  bool near_pull = false;
+  for (const auto& seg : new_boundary(s, kW, kH)) near_pull = near_pull || (seg.a - s.rest_position(pulled)).norm() < 1.01 * kCell;
+  EXPECT_TRUE(near_pull);
+}

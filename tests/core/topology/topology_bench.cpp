@@ -1,0 +1,114 @@
+// Topology costs on the 20k-vertex retina (build_retina_cap): a blade stroke cutting ~50 springs,
+// and vitrector suction per step (attraction every step, removal at every cut of a 5000 cpm
+// guillotine). Reports p50/p99/max per operation in µs. Targets (design guide): stroke p99 ≤ 200 µs,
+// suction per step p99 ≤ 100 µs.
+//   build/test/bench/bench_topology --benchmark_format=json
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "core/anatomy/retina_cap.hpp"
+#include "core/topology/cut.hpp"
+#include "core/topology/vitrector.hpp"
+
+using namespace vitreo::core;
+
+namespace {
+
+void report(benchmark::State& state, std::vector<double>& us) {
+  if (us.empty()) return;
+  std::sort(us.begin(), us.end());
+  auto q = [&](double p) { return us[static_cast<std::size_t>(p * static_cast<double>(us.size() - 1))]; };
+  state.counters["p50_us"] = q(0.5);
+  state.counters["p99_us"] = q(0.99);
+  state.counters["max_us"] = us.back();
+}
+
+RetinaCapScene retina(int vertices) {
+  RetinaCapOptions o;
+  o.retina_vertices = vertices;
+  o.detachment = false;
+  o.retina.tear_strain = INFINITY;
+  return build_retina_cap(o);
+}
+
+// Point on the retina (sphere radius 12) at polar angle theta from the posterior pole, azimuth phi.
+Vec3 on_globe(double theta, double phi, double r = 12.0) {
+  return r * Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), -std::cos(theta));
+}
+
+void BM_BladeStroke(benchmark::State& state) {
+  auto scene = retina(static_cast<int>(state.range(0)));
+  Surface& s = scene.world.surface(scene.retina);
+  Cutter cutter(s);
+  std::vector<double> us;
+  std::uint32_t opened = 0, strokes = 0, split = 0, snapped = 0, ends = 0;
+  double phi = 0.0;
+  for (auto _ : state) {
+    // A radial blade (through the retina, deep enough for the chord's sagitta) sweeping 7 mm along
+    // a meridian (~50 springs at 20k vertices); each stroke on fresh tissue.
+    phi += 0.1;
+    const Vec3 a = on_globe(0.3, phi), b = on_globe(0.3 + 7.0 / 12.0, phi);
+    const BladeEdge from{a * 0.9, a * 1.06}, to{b * 0.9, b * 1.06};
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = cutter.sweep(from, to);
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(r);
+    if (!r.status) {
+      state.SkipWithError(r.status.message().c_str());
+      break;
+    }
+    us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    opened += r.springs_opened;
+    split += r.springs_split;
+    snapped += r.snapped;
+    ends += r.end_points;
+    ++strokes;
+  }
+  state.counters["springs_opened_per_stroke"] = strokes ? static_cast<double>(opened) / strokes : 0.0;
+  state.counters["springs_split_per_stroke"] = strokes ? static_cast<double>(split) / strokes : 0.0;
+  state.counters["snapped_per_stroke"] = strokes ? static_cast<double>(snapped) / strokes : 0.0;
+  state.counters["ends_per_stroke"] = strokes ? static_cast<double>(ends) / strokes : 0.0;
+  state.counters["vertices"] = s.vertex_count();
+  report(state, us);
+}
+
+void BM_VitrectorStep(benchmark::State& state) {
+  auto scene = retina(static_cast<int>(state.range(0)));
+  TissueWorld& world = scene.world;
+  Surface& s = world.surface(scene.retina);
+  Vitrector vit(s);
+  (void)vit.set_vacuum(400.0);
+  (void)vit.set_cut_rate(5000.0);
+  std::vector<double> us;
+  double phi = 0.0, removed = 0.0;
+  int steps = 0;
+  for (auto _ : state) {
+    // The port hovers just in front of the retina and moves slowly across it.
+    phi += 0.0005;
+    const Vec3 surface_point = on_globe(0.8, phi);
+    (void)vit.set_pose(surface_point * (1.0 - 0.15 / 12.0), surface_point);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = vit.apply(1e-3);
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(r);
+    us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    removed += r.removed_mass_g;
+    if (++steps % 50 == 0) {  // let the tissue respond now and then (not timed)
+      state.PauseTiming();
+      (void)world.step(1e-3);
+      state.ResumeTiming();
+    }
+  }
+  state.counters["removed_mass_ug"] = removed * 1e6;
+  state.counters["vertices"] = s.vertex_count();
+  report(state, us);
+}
+
+}  // namespace
+
+BENCHMARK(BM_BladeStroke)->ArgName("vertices")->Arg(20000)->Unit(benchmark::kMicrosecond)->Iterations(60);
+BENCHMARK(BM_VitrectorStep)->ArgName("vertices")->Arg(20000)->Unit(benchmark::kMicrosecond)->Iterations(3000);
