@@ -6,6 +6,7 @@
 
 #include "core/anatomy/retina_cap.hpp"
 #include "core/instruments/instrument_system.hpp"
+#include "core/instruments/topology_adapter.hpp"
 #include "test_meshes.hpp"
 
 using namespace vitreo::core;
@@ -633,4 +634,42 @@ TEST(Instruments, PickLiftsOneEdgeWithoutTakingTheOther) {
   EXPECT_LT(left_max, 0.05);    // the other edge was not taken along
   EXPECT_EQ(sys.instrument(0).grip, kNone);
   for (std::uint32_t g = 0; g < 4; ++g) EXPECT_FALSE(world.grip_active(g));  // a pick never grabs
+}
+
+TEST(Instruments, ABladeCutFollowsItsPath) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
+  anchor_border(world.surface(m), 4.0);
+  TopologyAdapter topology(world, {m}, {});
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
+  sys.set_topology(&topology);
+  const std::uint32_t before = world.surface(m).vertex_slots();
+  auto at = [&](double x, double z) {
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z);
+    in.tip_fixture_mm.x() += x;
+    return in;
+  };
+  // Plunge at x = −1 to 0.4 mm through the membrane (the blade is 1 mm: its base stays above), then
+  // draw it along +x to x = +1 at 10 mm/s.
+  for (int i = 0; i <= 50; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-1.0, 0.6 - 1.0 * i / 50.0)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  for (int i = 1; i <= 200; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-1.0 + 2.0 * i / 200.0, -0.4)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
+  EXPECT_GT(topology.springs_opened(), 10u);
+  const Surface& s = world.surface(m);
+  ASSERT_GT(s.vertex_slots(), before);
+  // Every vertex the cut made lies on the blade's path (x from −1 to 1 along y = 0).
+  for (std::uint32_t v = before; v < s.vertex_slots(); ++v) {
+    if (!s.vertex_alive(v)) continue;
+    EXPECT_LT(std::abs(s.rest_position(v).y()), 0.05) << v;
+    EXPECT_GT(s.rest_position(v).x(), -1.1);
+    EXPECT_LT(s.rest_position(v).x(), 1.1);
+  }
 }
