@@ -673,3 +673,36 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
     EXPECT_LT(s.rest_position(v).x(), 1.1);
   }
 }
+
+TEST(Instruments, VitrectorRemovesOnlyAtItsPort) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t gel = world.add_surface(sheet(4.0, 40, 0.0));
+  anchor_border(world.surface(gel), 4.0);
+  TopologyAdapter topology(world, {}, {gel});
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(-10, 0, 0.6)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+  sys.set_topology(&topology);
+  // Shaft along +x just above the sheet, port turned down toward it.
+  InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], Vec3::UnitX(), 10.0, std::numbers::pi);
+  in.pedal = 1.0;
+  const double mass0 = world.surface(gel).total_mass();
+  for (int i = 0; i < 300; ++i) {
+    ASSERT_TRUE(sys.set_input(0, in));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
+  const Vec3 port = sys.instrument(0).tip.port_center;
+  EXPECT_LT(sys.instrument(0).tip.port_normal.z(), -0.99);
+  EXPECT_GT(topology.removed_mass_g(), 0.0);
+  EXPECT_NEAR(world.surface(gel).total_mass(), mass0 - topology.removed_mass_g(), 1e-12 + 1e-9 * mass0);
+  // Tissue that started beyond the suction field is all still there.
+  const Surface& s = world.surface(gel);
+  for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+    const auto tv = s.triangle_vertices(t);
+    const Vec3 c = (s.rest_position(tv[0]) + s.rest_position(tv[1]) + s.rest_position(tv[2])) / 3.0;
+    if ((c - port).norm() > o.vitrector_field_mm + 0.5) {
+      EXPECT_TRUE(s.triangle_alive(t)) << t;
+    }
+  }
+}
