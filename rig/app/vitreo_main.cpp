@@ -170,9 +170,9 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(s.inputs_applied), static_cast<unsigned long long>(s.inputs_refused),
                 static_cast<unsigned long long>(s.inputs_recorded), static_cast<unsigned long long>(s.recorder_dropped));
     for (const auto& line : s.device_lines) std::printf("  device           %s\n", line.c_str());
-    std::printf("  events           %llu tears, %llu attachments broken, %llu steps rolled back\n",
+    std::printf("  events           %llu tears, %llu attachments broken, %llu instrument events, %llu steps rolled back\n",
                 static_cast<unsigned long long>(s.tears), static_cast<unsigned long long>(s.attachments_broken),
-                static_cast<unsigned long long>(s.rolled_back));
+                static_cast<unsigned long long>(s.instrument_events), static_cast<unsigned long long>(s.rolled_back));
     std::printf("  telemetry        %llu messages (%llu dropped) → %s\n",
                 static_cast<unsigned long long>(s.telemetry_published), static_cast<unsigned long long>(s.telemetry_dropped),
                 config.lcm_url.c_str());

@@ -92,17 +92,27 @@ void capture_view(const SimulationModel& model, std::uint64_t step, double t_s, 
       snap.topology_version = s.topology_version();
     }
   }
-  const auto& slots = model.instruments();
-  for (std::size_t i = 0; i < slots.size() && i < 4; ++i) {
+  // Instruments as the simulation placed them (eye frame, after the eye's rotation).
+  const core::InstrumentSystem& sys = model.instrument_system();
+  for (std::uint32_t i = 0; i < 4; ++i) {
     auto& o = out.instruments[i];
-    o.present = slots[i].present;
-    o.inserted = slots[i].pose.inserted;
-    o.tool_type = slots[i].tool_type;
+    o.present = i < sys.instrument_count() && sys.instrument(i).input.present;
+    if (!o.present) continue;
+    const core::InstrumentState& st = sys.instrument(i);
+    o.inserted = st.inside;
+    o.tool_type = static_cast<int>(st.description.kind);
     for (int k = 0; k < 3; ++k) {
-      o.tip[k] = static_cast<float>(slots[i].pose.tip_mm[k]);
-      o.axis[k] = static_cast<float>(slots[i].pose.axis[k]);
+      o.tip[k] = static_cast<float>(st.frame.tip[k]);
+      o.axis[k] = static_cast<float>(st.frame.u[k]);
     }
   }
+  const core::LightExposure& light = sys.light();
+  out.light_active = light.active;
+  for (int k = 0; k < 3; ++k) {
+    out.light_apex[k] = static_cast<float>(light.apex_mm[k]);
+    out.light_axis[k] = static_cast<float>(light.axis[k]);
+  }
+  out.light_half_angle_deg = static_cast<float>(light.half_angle_rad * 180.0 / std::numbers::pi);
   out.zoom = model.controls().zoom;
   out.light_level = model.controls().light_level;
 }
@@ -183,16 +193,12 @@ render::FrameScene FrameBuilder::build(const ViewSnapshot& snap) {
     scene.meshes.push_back(shaft);
   }
 
-  // Endoillumination through the nasal port, aimed at the posterior pole (a chandelier-like light
-  // pipe until a tracked light pipe is in the other hand).
-  if (ports_.size() > 1) {
-    const core::Vec3 port = ports_[1].position_mm;
-    const core::Vec3 target(0.0, 0.0, -globe_radius_mm_ * 0.6);
-    const core::Vec3 dir = (target - port).normalized();
+  // Endoillumination: the light pipe's cone as the simulation placed it.
+  if (snap.light_active) {
     render::LightPipe light;
-    light.tip_mm = to_render(port + 3.0 * dir);
-    light.direction = to_render(dir);
-    light.cone_half_angle_deg = 45.0f;
+    light.tip_mm = {snap.light_apex[0], snap.light_apex[1], snap.light_apex[2]};
+    light.direction = {snap.light_axis[0], snap.light_axis[1], snap.light_axis[2]};
+    light.cone_half_angle_deg = snap.light_half_angle_deg;
     light.intensity = static_cast<float>(0.5 + snap.light_level);
     scene.light_pipe = light;
   }

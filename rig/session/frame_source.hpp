@@ -36,6 +36,10 @@ struct ViewSnapshot {
     int tool_type = 0;
   };
   Instrument instruments[4];
+  bool light_active = false;
+  float light_apex[3] = {};
+  float light_axis[3] = {};
+  float light_half_angle_deg = 40.0f;
   double zoom = 1.0;
   double light_level = 0.7;
 };

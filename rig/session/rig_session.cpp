@@ -25,7 +25,11 @@ telemetry::Event to_event(const core::TissueEvent& e, std::int64_t step, double 
   telemetry::Event ev;
   ev.step = step;
   ev.t_s = t_s;
-  ev.kind = e.kind == core::TissueEventKind::kTear ? telemetry::EventKind::Tear : telemetry::EventKind::AttachmentBroken;
+  switch (e.kind) {
+    case core::TissueEventKind::kTear: ev.kind = telemetry::EventKind::Tear; break;
+    case core::TissueEventKind::kGripBroken: ev.kind = telemetry::EventKind::Contact; break;  // tissue slipped out of the jaws
+    default: ev.kind = telemetry::EventKind::AttachmentBroken; break;
+  }
   ev.tissue_id = static_cast<std::int32_t>(e.surface);
   for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
   ev.magnitude = e.magnitude;
@@ -48,6 +52,22 @@ telemetry::InstrumentState to_state(const InstrumentSlot& slot, int id, std::int
   st.actuation = slot.pose.actuation;
   st.frozen = slot.frozen;
   return st;
+}
+
+telemetry::Event instrument_event(const core::InstrumentEvent& e, std::int64_t step, double t_s) {
+  telemetry::Event ev;
+  ev.step = step;
+  ev.t_s = t_s;
+  switch (e.kind) {
+    case core::InstrumentEventKind::kLaserBurn: ev.kind = telemetry::EventKind::Burn; break;
+    case core::InstrumentEventKind::kUnintendedTear: ev.kind = telemetry::EventKind::Tear; break;
+    case core::InstrumentEventKind::kAttachmentBroken: ev.kind = telemetry::EventKind::AttachmentBroken; break;
+    default: ev.kind = telemetry::EventKind::Contact; break;  // forces, collisions, grasps, light dose
+  }
+  ev.instrument_id = e.instrument == core::kNone ? std::int8_t{-1} : static_cast<std::int8_t>(e.instrument);
+  for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
+  ev.magnitude = e.magnitude;
+  return ev;
 }
 
 // Recorded at the last step so a replay knows how long the session ran.
@@ -144,6 +164,10 @@ SessionSummary run_session(const SessionConfig& config) {
     if (!report.ok) ++summary.rolled_back;
     for (const auto& e : model.world().events()) {
       if (e.kind != core::TissueEventKind::kRolledBack) physics_out.push(to_event(e, step, t_s));
+    }
+    for (const auto& e : model.instrument_system().events()) {
+      physics_out.push(instrument_event(e, step, t_s));
+      ++summary.instrument_events;
     }
     if (k % 4 == 0) {  // instrument state at 250 Hz (CHANNELS.md)
       const auto& slots = model.instruments();

@@ -44,6 +44,7 @@ struct SessionSummary {
   std::uint64_t telemetry_published = 0, telemetry_dropped = 0;
   std::uint64_t state_hash = 0;
   std::vector<std::string> device_lines;  // per device: name, link statistics
+  std::uint64_t instrument_events = 0;     // grasps, contacts, collisions, burns… (telemetry VITREO_EVENT)
   std::uint64_t frozen_steps = 0;          // steps during which an instrument was frozen (its tracker lost)
   std::uint64_t frames_rendered = 0, scenes_dropped = 0;
   std::vector<std::string> pngs;           // frames written

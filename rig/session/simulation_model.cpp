@@ -1,13 +1,45 @@
 #include "rig/session/simulation_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "core/common/state_hasher.hpp"
 
 namespace vitreo::rig {
 
 SimulationModel::SimulationModel(const ModelConfig& config)
-    : config_(config), scene_(core::build_retina_cap(config.scene)), pedals_(config.pedals) {}
+    : config_(config), scene_(core::build_retina_cap(config.scene)), pedals_(config.pedals) {
+  build_instruments();
+}
+
+void SimulationModel::build_instruments() {
+  core::InstrumentSceneOptions options;
+  for (const Port& p : config_.ports) options.ports_mm.push_back(p.position_mm);
+  options.retina_surface = scene_.retina;
+  options.macula_mm = core::Vec3(0.0, 0.0, -config_.scene.globe_radius_mm);
+  if (scene_.detachment_force != core::kNone) {
+    // The detachment drains through its centre (a break there), under gas.
+    core::DrainageSite site;
+    site.local_force = scene_.detachment_force;
+    const double c = config_.scene.detachment_center_deg * std::numbers::pi / 180.0;
+    site.break_point_mm = config_.scene.globe_radius_mm * core::Vec3(-std::sin(c), 0.0, -std::cos(c));
+    options.drainage_sites.push_back(site);
+  }
+  std::vector<core::InstrumentDescription> instruments;
+  for (std::size_t i = 0; i < config_.instruments.size() && i < config_.ports.size(); ++i) {
+    core::InstrumentDescription d;
+    d.kind = config_.instruments[i];
+    d.port = static_cast<std::uint32_t>(i);
+    instruments.push_back(d);
+  }
+  std::vector<std::uint32_t> surfaces;
+  for (std::uint32_t s = 0; s < scene_.world.surface_count(); ++s) surfaces.push_back(s);
+  system_.reset();
+  topology_ = std::make_unique<core::TopologyAdapter>(scene_.world, surfaces, surfaces);
+  system_ = std::make_unique<core::InstrumentSystem>(scene_.world, options, instruments);
+  system_->set_topology(topology_.get());
+}
 
 bool SimulationModel::apply(const telemetry::DeviceInput& in) {
   for (std::uint8_t i = 0; i < in.n_values && i < telemetry::DeviceInput::kMaxValues; ++i) {
@@ -25,7 +57,10 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       case 3: paused_ = true; break;   // Pause
       case 4: paused_ = false; break;  // Resume
       case 5:                          // Reset: the case as it was loaded, instruments out
+        system_.reset();
+        topology_.reset();
         scene_ = core::build_retina_cap(config_.scene);
+        build_instruments();
         pedals_ = PedalMapper(config_.pedals);
         instruments_ = {};
         eye_rotation_ = core::Quat::Identity();
@@ -49,7 +84,9 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       const int port = t.instrument_id < static_cast<int>(config_.ports.size()) ? t.instrument_id : -1;
       if (port >= 0 && !slot.frozen) {
         InstrumentPose pose;
-        ok = map_through_port(t.pose, config_.ports[static_cast<std::size_t>(port)], eye_rotation_, config_.calibration, pose);
+        // In the fixture frame: the instrument system applies the eye's rotation itself.
+        ok = map_through_port(t.pose, config_.ports[static_cast<std::size_t>(port)], core::Quat::Identity(),
+                              config_.calibration, pose);
         if (ok) {
           slot.present = true;
           slot.port = port;
@@ -66,6 +103,7 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
     const double n = e.orientation.coeffs().norm();
     if (std::abs(n - 1.0) < 1e-3) {
       eye_rotation_ = e.orientation.normalized();
+      eye_tracked_ = true;
       ok = true;
     }
   }
@@ -75,12 +113,34 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
 
 core::StepReport SimulationModel::step() {
   if (paused_) return {};
-  // Instruments wake the tissue where they are, so sleeping tissue responds to them.
-  for (const auto& slot : instruments_) {
-    if (slot.present && slot.pose.inserted) scene_.world.wake_sphere(slot.pose.tip_mm, 2.0);
+  const SurgicalControls& c = pedals_.controls();
+  for (std::uint32_t i = 0; i < system_->instrument_count(); ++i) {
+    const InstrumentSlot& slot = instruments_[i];
+    core::InstrumentInput in;
+    if (slot.present) {
+      // A frozen instrument (tracker lost) holds its last pose and lets go of nothing it holds.
+      in.present = slot.pose.inserted;
+      in.tip_fixture_mm = slot.pose.tip_mm;
+      in.axis_fixture = slot.pose.axis;
+      in.twist_rad = slot.pose.roll_rad;
+      in.actuation = slot.pose.actuation;
+    } else if (config_.instruments[i] == core::InstrumentKind::kLightPipe) {
+      // Untracked light pipe: held through its port, 6 mm in, toward the posterior pole.
+      const core::Vec3 port = config_.ports[i].position_mm;
+      const core::Vec3 target(0.0, 0.0, -0.6 * config_.scene.globe_radius_mm);
+      in = core::InstrumentInput::through_port(port, (target - port).normalized(), 6.0);
+    } else {
+      in.present = false;
+    }
+    const double vacuum = pedals_.mapping().vacuum_max_mmhg > 0.0 ? c.vacuum_mmhg / pedals_.mapping().vacuum_max_mmhg : 0.0;
+    in.pedal = std::clamp(vacuum, 0.0, 1.0);
+    in.trigger = c.laser_fire;
+    in.light_power_mw = 5.0 + 10.0 * c.light_level;
+    (void)system_->set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
+  system_->set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
-  return scene_.world.step(config_.dt_s);
+  return system_->step(config_.dt_s).tissue;
 }
 
 std::uint64_t SimulationModel::state_hash() const {

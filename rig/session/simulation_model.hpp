@@ -6,10 +6,13 @@
 // why a replay ends in the same state hash as the session it recorded.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "core/anatomy/retina_cap.hpp"
+#include "core/instruments/instrument_system.hpp"
+#include "core/instruments/topology_adapter.hpp"
 #include "rig/input/controls.hpp"
 #include "rig/input/port_pivot.hpp"
 #include "rig/session/device_inputs.hpp"
@@ -32,6 +35,10 @@ struct ModelConfig {
   PedalMapping pedals;
   TrackerCalibration calibration;
   std::vector<Port> ports;  // instrument i goes through port i (if present)
+  // What each tracked instrument is (index = tracker's instrument id = port); the light pipe in the
+  // second port, aimed at the posterior pole, stands in for the surgeon's other hand unless a
+  // tracker drives it.
+  std::vector<core::InstrumentKind> instruments = {core::InstrumentKind::kForceps, core::InstrumentKind::kLightPipe};
 };
 
 struct InstrumentSlot {
@@ -59,6 +66,7 @@ class SimulationModel {
   std::uint64_t resets() const { return resets_; }
 
   core::TissueWorld& world() { return scene_.world; }
+  const core::InstrumentSystem& instrument_system() const { return *system_; }
   const core::TissueWorld& world() const { return scene_.world; }
   const core::RetinaCapScene& scene() const { return scene_; }
   const SurgicalControls& controls() const { return pedals_.controls(); }
@@ -72,7 +80,12 @@ class SimulationModel {
 
  private:
   ModelConfig config_;
+  void build_instruments();
+
   core::RetinaCapScene scene_;
+  std::unique_ptr<core::TopologyAdapter> topology_;
+  std::unique_ptr<core::InstrumentSystem> system_;
+  bool eye_tracked_ = false;  // an eyeball fixture reports the eye's rotation
   PedalMapper pedals_;
   std::array<InstrumentSlot, 4> instruments_{};
   core::Quat eye_rotation_ = core::Quat::Identity();
