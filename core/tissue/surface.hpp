@@ -154,6 +154,9 @@ class Surface {
     Status status = Status::ok();
     std::uint32_t vertex = kNone;  // the new vertex
   };
+  // split_edge / split_triangle refuse to create a spring with a shorter rest length than this
+  // (a sliver whose rest shape puts the new vertex on an existing one).
+  static constexpr double kMinNewSpringRest_mm = 1e-6;
   // True when the pools can take this many more vertices, springs and triangles.
   bool has_room(std::uint32_t vertices, std::uint32_t edges, std::uint32_t triangles) const;
   // Inserts a vertex on spring e at parameter t ∈ (0, 1) measured from edge_vertices(e)[0] and splits

@@ -90,6 +90,19 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
     s.area = tri_rest_area_[tri];
     s.traction = 0.5 * (edge_traction_[s.e_ao] + edge_traction_[s.e_bo]);
   }
+  // Refuse a split that would make a degenerate spring (a sliver whose opposite vertex rests on
+  // the split point): nothing has changed yet.
+  if (t * r_ab.norm() < kMinNewSpringRest_mm || (1.0 - t) * r_ab.norm() < kMinNewSpringRest_mm) {
+    r.status = Status::error("split_edge: a piece would be shorter than the minimum spring rest length");
+    return r;
+  }
+  for (int i = 0; i < n; ++i) {
+    const Side& sd = sides[static_cast<std::size_t>(i)];
+    if ((sd.r_a_o - t * r_ab).norm() < kMinNewSpringRest_mm) {
+      r.status = Status::error("split_edge: the split point rests on an opposite vertex (degenerate spring)");
+      return r;
+    }
+  }
   for (auto tri : tris) {
     if (tri != kNone) free_triangle(tri);
   }
@@ -148,6 +161,11 @@ Surface::SplitResult Surface::split_triangle(TriangleId id, const std::array<dou
   const Vec3 r_ac = -oriented_rest(e_ca, c);
   const Vec3 r_ap = w[1] * r_ab + w[2] * r_ac;
   const double traction = (edge_traction_[e_ab] + edge_traction_[e_bc] + edge_traction_[e_ca]) / 3.0;
+  if (r_ap.norm() < kMinNewSpringRest_mm || (r_ap - r_ab).norm() < kMinNewSpringRest_mm ||
+      (r_ap - r_ac).norm() < kMinNewSpringRest_mm) {
+    r.status = Status::error("split_triangle: the point rests on a corner (degenerate spring)");
+    return r;
+  }
   free_triangle(t);
 
   const std::uint32_t p = allocate_vertex();

@@ -29,6 +29,7 @@ struct Ops {
   double w, h;
   double removed = 0.0;
   std::uint32_t refused = 0;
+  bool suction = true;  // false: suction cuts become pulls (keeps material for long runs)
   Ops(Surface& surface, unsigned seed, double width, double height)
       : s(surface), cutter(surface), vit(surface), rng(seed), w(width), h(height) {}
   double u(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); }
@@ -81,7 +82,7 @@ struct Ops {
       }
       return "scissors";
     }
-    if (kind <= 8) {  // suction cut
+    if (kind <= 8 && suction) {  // suction cut
       VitrectorSettings vs;
       const Vec3 port = point() + Vec3(0, 0, u(-0.1, 0.3));
       (void)vit.set_pose(port, Vec3(u(-0.5, 0.5), u(-0.5, 0.5), -1));
@@ -142,9 +143,11 @@ TEST(TopologyProperty, RandomOperationsThenOneSecondOfSimulationStayFiniteAndSet
   Ops o(s, 77, 3.0, 2.0);
   double min_rest = INFINITY;
   ASSERT_TRUE(o.vit.set_vacuum(300.0));
+  const double area0 = s.total_rest_area();
   for (int i = 0; i < ops; ++i) {
+    o.suction = s.total_rest_area() > 0.5 * area0;  // keep at least half the sheet to simulate
     const char* what = o.step();
-    {
+    if (!long_tests() || i % 100 == 0) {  // every operation by default; the long run samples
       const auto report = check_surface(s);
       ASSERT_TRUE(report.ok()) << "op " << i << " (" << what << "): " << report.summary();
       double sh = INFINITY;
@@ -179,6 +182,8 @@ TEST(TopologyProperty, RandomOperationsThenOneSecondOfSimulationStayFiniteAndSet
     if (i == 20) ke_early = world.energy().kinetic;
   }
   const double ke_end = world.energy().kinetic;
+  EXPECT_GT(s.triangle_count(), 50u) << "there must be tissue left to simulate";
+  EXPECT_GT(ke_early, 0.0);
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
     if (!s.vertex_alive(v)) continue;
     ASSERT_TRUE(std::isfinite(s.position(v).norm()) && std::isfinite(s.velocity(v).norm()));
