@@ -11,6 +11,8 @@ namespace vitreo::core {
 
 namespace {
 constexpr double kMaxDt_s = 0.02;
+// The smallest spring a tear may split (10 µm, the topology engine's floor on piece size).
+constexpr double kMinTearRest_mm = 0.01;
 }
 
 // Only awake vertices can change during a step (sleeping ones are skipped, and wake-ups are applied
@@ -183,6 +185,9 @@ void TissueWorld::find_overstrained() {
       const auto [a, b] = view.edge_v[e];
       const double len2 = (view.x[b] - view.x[a]).squaredNorm();
       const double limit2 = f2 * view.rest_len[e] * view.rest_len[e];
+      // Springs already shorter than kMinTearRest_mm are not split again: repeated tears at one
+      // spot would otherwise halve them towards zero length (and zero-area triangles).
+      if (view.rest_len[e] < kMinTearRest_mm) return;
       if (len2 > limit2 && tear_candidates_.size() < tear_candidates_.capacity()) {
         tear_candidates_.push_back({si, e, std::sqrt(len2) / view.rest_len[e] - 1.0});
       }
