@@ -9,14 +9,14 @@ packages=(
   # core
   libeigen3-dev libfcl-dev libccd-dev liboctomap-dev
   # rig: rendering, telemetry, USB, config, CLI, logging, images
-  libegl-dev libegl-mesa0 libgles-dev libgl1-mesa-dri libgbm-dev libgl-dev
+  libegl-dev libegl-mesa0 libgles-dev libgl1-mesa-dri libgbm-dev libgl-dev libdrm-dev
   liblcm-dev liblcm-bin
   libusb-1.0-0-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libpng-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   umockdev libumockdev-dev can-utils iproute2 util-linux
-  # SocketCAN tests run inside a small qemu VM (the host kernel has no CAN)
+  # SocketCAN and KMS display tests run inside a small qemu VM (the host kernel has neither)
   qemu-system-x86 linux-image-amd64 busybox-static cpio
   # protocol fuzz targets: clang's libFuzzer (GCC has none)
   clang libclang-rt-14-dev

@@ -65,6 +65,22 @@ std::string series_prefix(const std::string& dir, std::uint64_t step) {
 }
 }  // namespace
 
+void RenderThread::present_on_displays(const StereoFrame& frame, std::vector<std::unique_ptr<KmsDisplay>>& displays) {
+  if (displays.empty()) return;
+  const RgbaView sbs{frame.rgba.data(), frame.width(), frame.eye_height, 4 * static_cast<std::size_t>(frame.width())};
+  for (auto it = displays.begin(); it != displays.end();) {
+    try {
+      (*it)->present(sbs);
+      ++it;
+    } catch (const KmsError& e) {
+      // A display that went away must not take the other outputs (or the simulation) with it.
+      spdlog::error("render thread: display dropped: {}", e.what());
+      display_errors_.fetch_add(1, std::memory_order_acq_rel);
+      it = displays.erase(it);
+    }
+  }
+}
+
 std::optional<std::string> RenderThread::error() const {
   std::lock_guard lock(mutex_);
   return error_;
@@ -74,15 +90,21 @@ void RenderThread::run(std::promise<void>& started) {
   std::unique_ptr<EglContext> context;
   std::unique_ptr<StereoRenderer> renderer;
   std::unique_ptr<FrameRingWriter> ring;
+  std::vector<std::unique_ptr<KmsDisplay>> displays;
   try {
     context = std::make_unique<EglContext>(options_.egl);
     renderer = std::make_unique<StereoRenderer>(options_.render);
     if (!options_.shm_ring_name.empty())
       ring = std::make_unique<FrameRingWriter>(options_.shm_ring_name, options_.render.eye_width,
                                                options_.render.eye_height, options_.shm_ring_slots);
+    for (const KmsOptions& d : options_.displays) {
+      displays.push_back(std::make_unique<KmsDisplay>(d));
+      display_descriptions_.push_back(displays.back()->description());
+    }
     context_description_ = context->description();
     started.set_value();
   } catch (...) {
+    displays.clear();
     renderer.reset();
     context.reset();
     started.set_exception(std::current_exception());
@@ -103,6 +125,7 @@ void RenderThread::run(std::promise<void>& started) {
       }
       renderer->render(*scene, frame);
       if (ring) ring->write(frame);
+      present_on_displays(frame, displays);
       std::string prefix;
       {
         std::lock_guard lock(mutex_);
@@ -138,6 +161,7 @@ void RenderThread::run(std::promise<void>& started) {
     error_ = e.what();
   }
   ring.reset();
+  displays.clear();
   renderer.reset();
   context.reset();
 }

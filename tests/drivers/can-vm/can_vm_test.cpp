@@ -1,4 +1,4 @@
-// SocketCAN tests. Runs inside the qemu VM (run-in-vm.sh) as PID 1's child, with vcan0 up at MTU
+// SocketCAN tests. Runs inside the qemu VM (tests/vm/run-in-vm.sh) as PID 1's child, with vcan0 up at MTU
 // 72, can-utils in /bin and the protocol test vectors in /data. A plain main, not GoogleTest: it
 // is one static binary and one CTest test (the VM boots once for all of it).
 #include <fcntl.h>

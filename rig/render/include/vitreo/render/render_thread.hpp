@@ -18,6 +18,7 @@
 
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/frame_scene.hpp"
+#include "vitreo/render/kms_display.hpp"
 #include "vitreo/render/latest_slot.hpp"
 #include "vitreo/render/renderer.hpp"
 
@@ -33,6 +34,10 @@ struct RenderThreadOptions {
   /// stop() are written to <png_dir>/step_<step>_{left,right,stereo}.png. The directory must exist.
   std::string png_dir;
   std::uint64_t png_every_frames = 0;
+  /// The rig's displays (KMS scan-out), opened on the render thread at start (a failure is a start
+  /// failure, with the reason). A display that fails later (unplugged) is dropped with an error in
+  /// the log and display_errors(); rendering and the other outputs go on.
+  std::vector<KmsOptions> displays;
   /// Called on the render thread after each frame (keep it short; it delays the next frame only).
   std::function<void(const StereoFrame&)> on_frame;
 };
@@ -62,11 +67,15 @@ class RenderThread {
   /// The first error raised on the render thread after start-up (rendering then stops), if any.
   std::optional<std::string> error() const;
   const std::string& context_description() const { return context_description_; }
+  /// One line per display opened ("card0 HDMI-A-1 1920x1080@60 (page flip)").
+  const std::vector<std::string>& display_descriptions() const { return display_descriptions_; }
+  std::uint64_t display_errors() const { return display_errors_.load(std::memory_order_acquire); }
   /// Prefixes ("<dir>/step_<step>") of the PNG series written so far (png_dir).
   std::vector<std::string> pngs_written() const;
 
  private:
   void run(std::promise<void>& started);
+  void present_on_displays(const StereoFrame& frame, std::vector<std::unique_ptr<KmsDisplay>>& displays);
   RenderThreadOptions options_;
   LatestSlot<FrameScene> mailbox_;
   std::atomic<bool> stop_{false};
@@ -78,6 +87,8 @@ class RenderThread {
   std::optional<std::string> error_;
   std::vector<std::string> pngs_written_;
   std::string context_description_;
+  std::vector<std::string> display_descriptions_;
+  std::atomic<std::uint64_t> display_errors_{0};
   std::thread thread_;
 };
 
