@@ -23,6 +23,7 @@
 
 #include "drivers/can.hpp"
 #include "drivers/sim/can_sim.hpp"
+#include "vm_checks.hpp"
 
 extern char** environ;
 
@@ -31,17 +32,6 @@ namespace {
 using namespace vitreo::drivers;
 using vitreo::proto::Bytes;
 
-int g_fail = 0, g_checks = 0;
-#define CHECK(c, ...)                                                  \
-  do {                                                                 \
-    ++g_checks;                                                        \
-    if (!(c)) {                                                        \
-      std::printf("FAIL %s:%d: %s: ", __FILE__, __LINE__, #c);         \
-      std::printf(__VA_ARGS__);                                        \
-      std::printf("\n");                                               \
-      ++g_fail;                                                        \
-    }                                                                  \
-  } while (0)
 
 const char* kIf = "vcan0";
 std::string g_data = "/data";

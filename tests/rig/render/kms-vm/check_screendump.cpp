@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "kms_vm_test_checks.hpp"
+#include "vm_checks.hpp"
 #include "test_pattern.hpp"
 
 namespace kt = vitreo::kms_test;

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <string>
 
-#include "kms_vm_test_checks.hpp"
+#include "vm_checks.hpp"
 #include "test_pattern.hpp"
 #include "vitreo/render/kms_display.hpp"
 

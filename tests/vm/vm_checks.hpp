@@ -1,5 +1,6 @@
 #pragma once
-// Minimal checks for the plain-main VM test (no GoogleTest in the static VM binary).
+// Minimal checks for the plain-main programs that run inside the test VM (static binaries, one boot
+// for all their checks: no GoogleTest) and their host-side checkers.
 #include <cstdio>
 #include <string>
 
