@@ -33,6 +33,16 @@ void ScoreOptions::validate() const {
   }
 }
 
+std::uint32_t SessionTotals::iatrogenic_events() const {
+  using K = InstrumentEventKind;
+  std::uint32_t n = 0;
+  for (K k : {K::kExcessiveRetinaForce, K::kUnintendedTear, K::kLaserOnDetachedRetina, K::kLightTooClose, K::kLightToxicity,
+              K::kInstrumentCollision, K::kLensTouch, K::kWallContact}) {
+    n += count(k);
+  }
+  return n;
+}
+
 const ScoreEntry* ScoreCard::find(std::string_view name) const {
   for (const auto& c : categories) {
     if (name == c.name) return &c;

@@ -42,6 +42,9 @@ struct SessionTotals {
   double lit_working_time_s = 0.0;           // ... with the tip inside the light cone
 
   std::uint32_t count(InstrumentEventKind k) const { return events[static_cast<std::size_t>(k)]; }
+  // Events that harm the eye or show loss of control: excessive retina force, unintended tears,
+  // laser on detached retina, light too close / toxic, instrument collisions, lens and wall touches.
+  std::uint32_t iatrogenic_events() const;
 };
 
 // Reference values and weights. The defaults are chosen, not calibrated: they make one serious

@@ -90,6 +90,11 @@ TEST(Scores, MoreDamageLowersTissueTreatment) {
       last = now;
     }
   }
+  SessionTotals t = ordinary();
+  t.events[static_cast<std::size_t>(InstrumentEventKind::kLensTouch)] = 2;
+  t.events[static_cast<std::size_t>(InstrumentEventKind::kUnintendedTear)] = 1;
+  t.events[static_cast<std::size_t>(InstrumentEventKind::kGrasp)] = 5;  // not harm
+  EXPECT_EQ(t.iatrogenic_events(), 3u);
   // Nothing but ordinary contact costs little; no contact at all is the full score.
   SessionTotals clean = ordinary();
   clean.peak_retina_force_un = clean.retina_force_impulse_un_s = 0.0;

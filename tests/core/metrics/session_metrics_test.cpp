@@ -7,6 +7,7 @@
 #include <numbers>
 #include <tuple>
 
+#include "alloc_counter.hpp"
 #include "core/metrics/session_metrics.hpp"
 #include "test_meshes.hpp"
 
@@ -201,6 +202,32 @@ TEST(SessionMetrics, RefusesBadDtAndASecondObserveOfTheSameStep) {
   MetricsCase wrong = b.metrics_case();
   wrong.criteria.push_back({CriterionKind::kMembraneRemoved, "none", 0.5});
   EXPECT_THROW(SessionMetrics(b.world, wrong, b.instruments.get()), InvalidArgument);
+}
+
+TEST(SessionMetrics, ObserveCriteriaAndScoreDoNotAllocate) {
+  Bench b;
+  MetricsCase c = b.metrics_case();
+  c.criteria = {{CriterionKind::kRetinaFlat, "", 0.3}, {CriterionKind::kTimeLimit, "", 10.0}};
+  SessionMetrics m(b.world, c, b.instruments.get());
+  (void)m.score();
+  // The counter itself counts.
+  test::AllocationCounter::counting = true;
+  std::vector<double>* probe = new std::vector<double>(8);
+  test::AllocationCounter::counting = false;
+  delete probe;
+  ASSERT_EQ(test::AllocationCounter::allocations, 2);
+  test::AllocationCounter::allocations = 0;
+  for (int i = 0; i < 300; ++i) {
+    b.step_at(Vec3(0.0, 0.0, i % 100 < 50 ? 1.0 : -0.3));
+    test::AllocationCounter::counting = true;
+    const Status st = m.observe(kDt);
+    const ScoreCard& card = m.score();
+    test::AllocationCounter::counting = false;
+    ASSERT_TRUE(st);
+    ASSERT_EQ(card.categories.size(), 4u);
+  }
+  EXPECT_EQ(test::AllocationCounter::allocations, 0);
+  EXPECT_EQ(m.totals().retina_contacts, 3u);
 }
 
 TEST(SessionMetrics, SameSessionSameNumbers) {
