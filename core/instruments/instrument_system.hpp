@@ -216,6 +216,7 @@ class InstrumentSystem {
   // The fluid–gas boundary (+infinity: all fluid). The tissue world's environment follows it in
   // 0.05 mm increments (each change re-evaluates buoyancy everywhere, so it is not pushed every step).
   double fluid_level_z_mm() const { return fluid_level_; }
+  const InstrumentSceneOptions& options() const { return options_; }
   const CollisionStats& collision_stats() const { return collision_->stats(); }
   const CollisionScene& collision() const { return *collision_; }
   // Current position of a burn spot on the deformed tissue.

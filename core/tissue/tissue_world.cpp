@@ -172,6 +172,12 @@ Status TissueWorld::set_local_force_scale(std::uint32_t force, double scale) {
   return Status::ok();
 }
 
+bool TissueWorld::attachment_holds(std::uint32_t i) const {
+  const Attachment& at = attachments_.at(i);
+  if (!at.intact || !surfaces_[at.d.surface_a]->is_current(at.a)) return false;
+  return at.d.surface_b == AttachmentDescription::kWorld || surfaces_[at.d.surface_b]->is_current(at.b);
+}
+
 double TissueWorld::total_mass() const {
   double m = 0.0;
   for (const auto& s : surfaces_) m += s->total_mass();

@@ -212,6 +212,8 @@ class TissueWorld {
   const SolverSettings& settings() const { return settings_; }
   std::uint32_t attachment_count() const { return static_cast<std::uint32_t>(attachments_.size()); }
   bool attachment_intact(std::uint32_t i) const { return attachments_.at(i).intact; }
+  // Intact and both ends still exist (a removed or cut-away end is only marked broken at the next step).
+  bool attachment_holds(std::uint32_t i) const;
   // Force the attachment carried during the last step (µN): the constraint multiplier over h².
   double attachment_force(std::uint32_t i) const { return attachments_.at(i).last_force_un; }
   // Events of the last step (valid until the next step).

@@ -1,0 +1,156 @@
+#include "core/metrics/session_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/common/validate.hpp"
+
+namespace vitreo::core {
+
+void MetricsOptions::validate() const {
+  require_range(contact_force_un, 0.0, 1e6, "metrics: contact_force_un");
+  require_range(retina_force_limit_un, -1e12, 1e12, "metrics: retina_force_limit_un");
+  require_range(laser_target_band_mm, 0.0, 10.0, "metrics: laser_target_band_mm");
+  progress.validate();
+  scores.validate();
+}
+
+SessionMetrics::SessionMetrics(const Scene& scene, const InstrumentSystem* instruments, MetricsOptions options)
+    : SessionMetrics(scene.world, MetricsCase::from_scene(scene), instruments, std::move(options)) {}
+
+SessionMetrics::SessionMetrics(const TissueWorld& world, MetricsCase c, const InstrumentSystem* instruments,
+                               MetricsOptions options)
+    : world_(world),
+      instruments_(instruments),
+      options_((options.validate(), std::move(options))),
+      progress_(world, std::move(c), options_.progress) {
+  for (const auto& spec : progress_.description().criteria) {
+    if (spec.kind == CriterionKind::kTimeLimit) time_limit_s_ = time_limit_s_ > 0.0 ? std::min(time_limit_s_, spec.threshold) : spec.threshold;
+  }
+  totals_.force_limit_un = options_.retina_force_limit_un;
+  if (instruments_) {
+    if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = instruments_->options().retina_force_limit_un;
+    const std::uint32_t n = instruments_->instrument_count();
+    per_instrument_.resize(n);
+    last_tip_.assign(n, Vec3::Zero());
+    was_inside_.assign(n, 0);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const InstrumentState& st = instruments_->instrument(i);
+      per_instrument_[i].kind = st.description.kind;
+      last_tip_[i] = st.frame.tip;
+      was_inside_[i] = st.inside ? 1 : 0;
+      if (st.description.kind == InstrumentKind::kLightPipe) totals_.illumination_measured = true;
+    }
+    burns_seen_ = instruments_->burns().size();
+  }
+  if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = InstrumentSceneOptions{}.retina_force_limit_un;
+  last_world_step_ = world_.step_count();
+  card_.categories.reserve(4);
+}
+
+Status SessionMetrics::observe(double dt) {
+  if (!std::isfinite(dt) || !(dt > 0.0) || dt > 0.02) return Status::error("metrics: dt must be in (0, 0.02] s");
+  const auto& world_events = world_.events();
+  const bool rolled_back = std::any_of(world_events.begin(), world_events.end(),
+                                       [](const TissueEvent& e) { return e.kind == TissueEventKind::kRolledBack; });
+  if (world_.step_count() == last_world_step_ && !rolled_back) {
+    return Status::error("metrics: no physics step since the last observe()");
+  }
+  last_world_step_ = world_.step_count();
+  totals_.elapsed_s += dt;
+  ++totals_.steps;
+
+  for (const TissueEvent& e : world_events) {
+    if (e.kind != TissueEventKind::kTear) continue;
+    if (e.surface == progress_.description().retina) {
+      ++totals_.retina_tears;
+    } else {
+      ++totals_.other_tears;
+    }
+  }
+  if (!instruments_) return Status::ok();
+
+  const double limit = totals_.force_limit_un;
+  const LightExposure& light = instruments_->light();
+  const double cos_cone = std::cos(light.half_angle_rad);
+  for (std::uint32_t i = 0; i < per_instrument_.size(); ++i) {
+    const InstrumentState& st = instruments_->instrument(i);
+    InstrumentMetrics& m = per_instrument_[i];
+    // Odometer: only the path between two steps the tip spent inside the eye.
+    if (st.inside && was_inside_[i]) {
+      const double d = (st.frame.tip - last_tip_[i]).norm();
+      m.path_length_mm += d;
+      totals_.path_length_mm += d;
+    }
+    last_tip_[i] = st.frame.tip;
+    was_inside_[i] = st.inside ? 1 : 0;
+
+    const double f = st.retina_force_un;
+    const bool touching = f > options_.contact_force_un;
+    if (touching && !m.touching_retina) {
+      ++m.retina_contacts;
+      ++totals_.retina_contacts;
+    }
+    m.touching_retina = touching;
+    if (touching) {
+      m.retina_contact_time_s += dt;
+      totals_.retina_contact_time_s += dt;
+    }
+    m.peak_retina_force_un = std::max(m.peak_retina_force_un, f);
+    totals_.peak_retina_force_un = std::max(totals_.peak_retina_force_un, f);
+    m.retina_force_impulse_un_s += f * dt;
+    totals_.retina_force_impulse_un_s += f * dt;
+    if (f > limit) {
+      m.time_over_force_limit_s += dt;
+      totals_.time_over_force_limit_s += dt;
+    }
+
+    // Illumination: a working tip (not the light pipe itself) inside the eye and inside the cone.
+    if (totals_.illumination_measured && st.inside && st.description.kind != InstrumentKind::kLightPipe) {
+      totals_.working_time_s += dt;
+      if (light.active) {
+        const Vec3 to = st.frame.tip - light.apex_mm;
+        const double d = to.norm();
+        if (d > 0.0 && to.dot(light.axis) >= cos_cone * d) totals_.lit_working_time_s += dt;
+      }
+    }
+  }
+
+  for (const InstrumentEvent& e : instruments_->events()) {
+    const auto k = static_cast<std::size_t>(e.kind);
+    if (k < totals_.events.size()) ++totals_.events[k];
+  }
+  const auto& burns = instruments_->burns();
+  for (; burns_seen_ < burns.size(); ++burns_seen_) {
+    const BurnSpot& b = burns[burns_seen_];
+    if (progress_.distance_to_laser_ring(b.position_mm) <= options_.laser_target_band_mm) {
+      ++totals_.burns_on_target;
+    } else {
+      ++totals_.burns_elsewhere;
+    }
+  }
+  return Status::ok();
+}
+
+const std::vector<CriterionProgress>& SessionMetrics::criteria() {
+  progress_.evaluate(world_, instruments_, totals_.elapsed_s);
+  return progress_.criteria();
+}
+
+bool SessionMetrics::complete() {
+  bool any = false;
+  for (const auto& c : criteria()) {
+    if (c.kind == CriterionKind::kTimeLimit) continue;
+    if (!c.met) return false;
+    any = true;
+  }
+  return any;
+}
+
+const ScoreCard& SessionMetrics::score() {
+  compute_scores(totals_, criteria(), time_limit_s_, options_.scores, card_);
+  return card_;
+}
+
+}  // namespace vitreo::core

@@ -1,0 +1,90 @@
+#pragma once
+// Session metrics: observes a running case once per physics step and keeps what a debriefing (and
+// the rig's score_t telemetry channel) needs — the tip path inside the eye ("odometer"), retinal
+// contacts and the force on the retina, iatrogenic events, laser spots on and off target, tears —
+// and, on demand, the case's criteria and the scores (case_progress.hpp, score_card.hpp).
+//
+//   core::Scene scene = core::build_scene(description);
+//   core::InstrumentSystem instruments(scene.world, options, tools);
+//   core::SessionMetrics metrics(scene, &instruments);
+//   loop: instruments.set_input(...); instruments.step(dt); (void)metrics.observe(dt);
+//   metrics.criteria(), metrics.score()   // at a lower rate (each scans the world)
+//
+// Like the rest of core: no clock (dt is given), no allocation in observe() after construction,
+// the same observations give the same numbers bit for bit.
+#include <cstdint>
+#include <vector>
+
+#include "core/common/status.hpp"
+#include "core/instruments/instrument_system.hpp"
+#include "core/metrics/case_progress.hpp"
+#include "core/metrics/score_card.hpp"
+#include "core/scene/scene_builder.hpp"
+
+namespace vitreo::core {
+
+struct MetricsOptions {
+  // An instrument touches the retina while the retina's contact force on it exceeds this (µN).
+  double contact_force_un = 1.0;
+  // Force above which the retina is damaged (µN); ≤ 0: the InstrumentSystem's retina_force_limit_un.
+  double retina_force_limit_un = 0.0;
+  // A burn counts as on target within this distance (along the wall) of a laser-ring guide.
+  double laser_target_band_mm = 0.5;
+  ProgressOptions progress;
+  ScoreOptions scores;
+  void validate() const;  // throws InvalidArgument
+};
+
+struct InstrumentMetrics {
+  InstrumentKind kind = InstrumentKind::kLightPipe;
+  double path_length_mm = 0.0;            // tip path while inside the eye (eye frame)
+  std::uint32_t retina_contacts = 0;      // entries into contact
+  double retina_contact_time_s = 0.0;
+  double peak_retina_force_un = 0.0;
+  double retina_force_impulse_un_s = 0.0;
+  double time_over_force_limit_s = 0.0;
+  bool touching_retina = false;           // now
+};
+
+class SessionMetrics {
+ public:
+  // From a built scene; instruments may be null (tissue-only metrics). The metrics keep references
+  // to the world and the instruments: both must outlive them. Throws InvalidArgument on bad options
+  // or criteria that name what the case lacks.
+  SessionMetrics(const Scene& scene, const InstrumentSystem* instruments, MetricsOptions options = {});
+  // From a world built another way (core/anatomy/retina_cap), described by hand.
+  SessionMetrics(const TissueWorld& world, MetricsCase c, const InstrumentSystem* instruments, MetricsOptions options = {});
+
+  // Once after each physics step (InstrumentSystem::step or TissueWorld::step) of dt_s seconds.
+  // Refuses (changing nothing) a dt that is not finite and in (0, 0.02], and a second call without a
+  // world step in between (it would count the step's events twice).
+  Status observe(double dt_s);
+
+  const SessionTotals& totals() const { return totals_; }
+  const InstrumentMetrics& instrument(std::uint32_t i) const { return per_instrument_.at(i); }
+  std::uint32_t instrument_count() const { return static_cast<std::uint32_t>(per_instrument_.size()); }
+  TissueProgress tissue() const { return progress_.tissue(world_); }
+
+  // The case's criteria measured now (scans the world; no allocation).
+  const std::vector<CriterionProgress>& criteria();
+  // All criteria except the time limit met (false when the case has none).
+  bool complete();
+  // Criteria, then the scores (no allocation).
+  const ScoreCard& score();
+
+ private:
+  const TissueWorld& world_;
+  const InstrumentSystem* instruments_;
+  MetricsOptions options_;
+  CaseProgress progress_;
+  SessionTotals totals_;
+  std::vector<InstrumentMetrics> per_instrument_;
+  std::vector<Vec3> last_tip_;
+  std::vector<std::uint8_t> was_inside_;
+  std::size_t burns_seen_ = 0;
+  std::uint64_t last_world_step_ = 0;
+  double time_limit_s_ = 0.0;
+  ScoreCard card_;
+};
+
+}  // namespace vitreo::core

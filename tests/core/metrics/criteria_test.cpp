@@ -1,0 +1,320 @@
+// Criteria on real scenes (build_scene): each goes from unmet to met when the tissue it is about is
+// removed, released, cut, lasered, drained or flattened, and its value matches a reference worked out
+// independently (the vitrector's own accounting, the guide's arc lengths, max_retina_lift_mm).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/metrics/session_metrics.hpp"
+#include "core/topology/cut.hpp"
+#include "core/topology/vitrector.hpp"
+#include "core/tissue/surface_validity.hpp"
+
+namespace vitreo::core {
+namespace {
+
+constexpr double kDt = 1e-3;
+
+// A small eye with one of everything: a tear (so the retina starts lifted), a detachment, an
+// epiretinal membrane, a cut path and a laser ring, and every criterion about them.
+SceneDescription case_scene(bool gel) {
+  SceneDescription d;
+  d.name = "metrics";
+  d.anatomy.retina_vertices = 6000;
+  d.anatomy.gel_shells = gel ? 1 : 0;
+  d.texture_size_px = 64;
+  d.materials = default_materials();
+  d.tears.push_back({"u", {60.0, 120.0}, 2.5, 3.5, 0.8});
+  d.detachments.push_back({"fluid", {60.0, 300.0}, 20.0, 150.0});
+  MembraneSpec erm;
+  erm.name = "erm";
+  erm.center = {8.0, 0.0};
+  erm.size_mm = 3.0;
+  d.membranes.push_back(erm);
+  GuideSpec line;
+  line.name = "line";
+  line.kind = GuideKind::kCutPath;
+  line.points = {{40.0, 200.0}, {45.0, 220.0}, {40.0, 240.0}};
+  d.guides.push_back(line);
+  GuideSpec ring;
+  ring.name = "ring";
+  ring.kind = GuideKind::kLaserRing;
+  ring.center = {35.0, 60.0};
+  ring.radius_mm = 1.5;
+  d.guides.push_back(ring);
+  d.criteria = {{CriterionKind::kMembraneRemoved, "erm", 0.9}, {CriterionKind::kMembraneReleased, "erm", 0.9},
+                {CriterionKind::kPathCut, "line", 0.8},       {CriterionKind::kLaserCoverage, "ring", 0.8},
+                {CriterionKind::kDrained, "fluid", 0.05},     {CriterionKind::kRetinaFlat, "", 0.3},
+                {CriterionKind::kTimeLimit, "", 60.0}};
+  if (gel) d.criteria.push_back({CriterionKind::kGelRemoved, "", 0.3});
+  return d;
+}
+
+Scene build(bool gel = false) { return build_scene(case_scene(gel), {false, false}); }
+
+const CriterionProgress& find(const std::vector<CriterionProgress>& all, CriterionKind k) {
+  for (const auto& c : all) {
+    if (c.kind == k) return c;
+  }
+  ADD_FAILURE() << "no criterion " << to_string(k);
+  return all.front();
+}
+
+TEST(Criteria, NothingIsMetAtTheStartExceptTheTimeLimit) {
+  Scene scene = build(true);
+  SessionMetrics m(scene, nullptr);
+  for (const auto& c : m.criteria()) {
+    if (c.kind == CriterionKind::kTimeLimit) {
+      EXPECT_TRUE(c.met);
+      EXPECT_EQ(c.progress, 1.0);
+    } else {
+      EXPECT_FALSE(c.met) << to_string(c.kind);
+      EXPECT_EQ(c.progress, 0.0) << to_string(c.kind);
+    }
+  }
+  EXPECT_FALSE(m.complete());
+  const ScoreCard& s = m.score();
+  ASSERT_NE(s.find("target_achievement"), nullptr);
+  EXPECT_EQ(s.find("target_achievement")->value, 0.0);
+  EXPECT_EQ(s.find("efficiency")->value, 0.0);  // nothing done yet
+}
+
+TEST(Criteria, MembraneRemovedAndReleasedFollowTheVitrector) {
+  Scene scene = build();
+  SessionMetrics m(scene, nullptr);
+  const BuiltMembrane& erm = scene.membranes[0];
+  Surface& ms = scene.world.surface(erm.surface);
+  const double area0 = ms.total_rest_area();
+  const Vec3 c = scene.eye.wall_point(8.0 * std::numbers::pi / 180.0, 0.0);
+
+  // A small bite out of the middle: partly removed and released, neither met.
+  VitrectorSettings vs;
+  vs.field_radius_mm = 20.0;
+  vs.removal_radius_mm = 1.2;
+  Vitrector bite(ms, vs);
+  ASSERT_TRUE(bite.set_pose(c - 0.5 * c.normalized(), c.normalized()));
+  const VitrectorStepResult r1 = bite.cut_now();
+  ASSERT_TRUE(r1.status) << r1.status.message();
+  ASSERT_GT(r1.removed_area_mm2, 0.0);
+  auto removed = find(m.criteria(), CriterionKind::kMembraneRemoved);
+  EXPECT_NEAR(removed.value, r1.removed_area_mm2 / area0, 1e-12);
+  EXPECT_FALSE(removed.met);
+  const auto released = find(m.criteria(), CriterionKind::kMembraneReleased);
+  EXPECT_GT(released.value, 0.0);
+  EXPECT_LT(released.value, 0.9);
+  EXPECT_FALSE(released.met);
+  EXPECT_EQ(m.tissue().membrane_attachments, erm.attachment_count);
+  EXPECT_NEAR(m.tissue().membrane_area_removed_mm2, r1.removed_area_mm2, 1e-12);
+
+  // The rest of it: all removed, every attachment lost its membrane end.
+  vs.removal_radius_mm = 9.0;
+  Vitrector all(ms, vs);
+  ASSERT_TRUE(all.set_pose(c - 6.0 * c.normalized(), c.normalized()));
+  const VitrectorStepResult r2 = all.cut_now();
+  ASSERT_TRUE(r2.status) << r2.status.message();
+  removed = find(m.criteria(), CriterionKind::kMembraneRemoved);
+  EXPECT_NEAR(removed.value, (r1.removed_area_mm2 + r2.removed_area_mm2) / area0, 1e-12);
+  EXPECT_NEAR(removed.value, 1.0, 1e-9);
+  EXPECT_TRUE(removed.met);
+  EXPECT_TRUE(find(m.criteria(), CriterionKind::kMembraneReleased).met);
+  EXPECT_EQ(find(m.criteria(), CriterionKind::kMembraneReleased).value, 1.0);
+  // After the next step the world itself marks the attachments broken; the measure stays.
+  scene.world.step(kDt);
+  EXPECT_EQ(find(m.criteria(), CriterionKind::kMembraneReleased).value, 1.0);
+  for (std::uint32_t a = erm.first_attachment; a < erm.first_attachment + erm.attachment_count; ++a) {
+    EXPECT_FALSE(scene.world.attachment_intact(a));
+  }
+}
+
+TEST(Criteria, GelRemovedIsTheShareOfTheStartingGelVerticesGone) {
+  Scene scene = build(true);
+  SessionMetrics m(scene, nullptr);
+  Surface& gs = scene.world.surface(scene.gel);
+  // Reference: the vitrector takes the posterior half (z < 0): every vertex clearly behind the
+  // plane goes, none in front of it; those within a snap of the plane may stay.
+  std::uint32_t n = 0, behind = 0, clearly_behind = 0;
+  for (std::uint32_t v = 0; v < gs.vertex_slots(); ++v) {
+    if (!gs.vertex_alive(v)) continue;
+    ++n;
+    if (gs.position(v).z() < 0.0) ++behind;
+    if (gs.position(v).z() < -0.2) ++clearly_behind;
+  }
+  ASSERT_GT(clearly_behind, n / 5);
+  EXPECT_FALSE(find(m.criteria(), CriterionKind::kGelRemoved).met);
+  VitrectorSettings vs;
+  vs.field_radius_mm = 20.0;
+  vs.removal_radius_mm = 15.0;
+  Vitrector v(gs, vs);
+  ASSERT_TRUE(v.set_pose(Vec3::Zero(), -Vec3::UnitZ()));
+  ASSERT_TRUE(v.cut_now().status);
+  const auto gel = find(m.criteria(), CriterionKind::kGelRemoved);
+  EXPECT_GE(gel.value, static_cast<double>(clearly_behind) / n);
+  EXPECT_LE(gel.value, static_cast<double>(behind) / n);
+  EXPECT_TRUE(gel.met);
+  EXPECT_EQ(m.tissue().gel_vertices_initial, n);
+  EXPECT_TRUE(check_surface(gs).ok());
+}
+
+TEST(Criteria, PathCutIsTheShareOfTheGuideAlongANewCut) {
+  Scene scene = build();
+  SessionMetrics m(scene, nullptr);
+  const Guide& line = scene.guides[0];
+  ASSERT_EQ(line.name, "line");
+  Cutter cutter(scene.world.surface(scene.retina));
+  // A blade across the retina (radially) swept along the guide.
+  const auto blade = [](const Vec3& p) { return BladeEdge{p - 0.6 * p.normalized(), p + 0.6 * p.normalized()}; };
+  const std::size_t half = line.polyline_mm.size() / 2;
+  double total = 0.0, first = 0.0;
+  for (std::size_t k = 0; k + 1 < line.polyline_mm.size(); ++k) {
+    const double len = (line.polyline_mm[k + 1] - line.polyline_mm[k]).norm();
+    total += len;
+    if (k < half) first += len;
+  }
+  EXPECT_EQ(find(m.criteria(), CriterionKind::kPathCut).value, 0.0);
+  // A cut elsewhere (parallel, 15° nearer the pole) makes new boundary but none near the guide.
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  for (double az = 200.0; az < 240.0; az += 2.0) {
+    ASSERT_TRUE(cutter.sweep(blade(scene.eye.wall_point(25.0 * kDeg, az * kDeg)), blade(scene.eye.wall_point(25.0 * kDeg, (az + 2.0) * kDeg))).status);
+  }
+  EXPECT_EQ(find(m.criteria(), CriterionKind::kPathCut).value, 0.0);
+  for (std::size_t k = 0; k < half; ++k) {
+    ASSERT_TRUE(cutter.sweep(blade(line.polyline_mm[k]), blade(line.polyline_mm[k + 1])).status);
+  }
+  auto cut = find(m.criteria(), CriterionKind::kPathCut);
+  // The cut part, plus up to the tolerance beyond the crack tip.
+  EXPECT_GE(cut.value, first / total - 0.02);
+  EXPECT_LE(cut.value, (first + 0.25) / total + 0.02);
+  EXPECT_FALSE(cut.met);
+  for (std::size_t k = half; k + 1 < line.polyline_mm.size(); ++k) {
+    ASSERT_TRUE(cutter.sweep(blade(line.polyline_mm[k]), blade(line.polyline_mm[k + 1])).status);
+  }
+  cut = find(m.criteria(), CriterionKind::kPathCut);
+  EXPECT_GT(cut.value, 0.97);
+  EXPECT_TRUE(cut.met);
+  EXPECT_TRUE(check_surface(scene.world.surface(scene.retina)).ok());
+}
+
+TEST(Criteria, LaserCoverageCountsTheRingUnderAdheredBurns) {
+  Scene scene = build();
+  const SclerotomyPort* port = nullptr;
+  for (const auto& p : scene.eye.ports) {
+    if (p.name == "working_2") port = &p;
+  }
+  ASSERT_NE(port, nullptr);
+  InstrumentSceneOptions o;
+  o.ports_mm = {port->inner_mm};
+  o.retina_surface = scene.retina;
+  InstrumentSystem sys(scene.world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+  sys.set_eye_fixture_rotation(Quat::Identity());
+  SessionMetrics m(scene, &sys);
+  const Guide& ring = scene.guides[1];
+  ASSERT_EQ(ring.kind, GuideKind::kLaserRing);
+  const double lift = 0.5 * scene.eye.parameters.retina_thickness_mm;  // the guide lies this far inside
+  const auto fire = [&](const Vec3& target) {
+    const Vec3 dir = (target - o.ports_mm[0]).normalized();
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], dir, 4.0);
+    in.laser_power_mw = 800.0;  // 80 mJ: four times the reference energy, a 0.4 mm spot
+    in.laser_duration_s = 0.1;
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    ASSERT_TRUE(m.observe(kDt));
+    in.trigger = true;
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    ASSERT_TRUE(m.observe(kDt));
+  };
+  const auto on_ring = [&](std::size_t k) { return Vec3(ring.polyline_mm[k] + lift * ring.polyline_mm[k].normalized()); };
+  // Half the ring, a spot at every other polyline point (closer than a spot diameter).
+  const std::size_t n = ring.polyline_mm.size() - 1;  // closed: the last point is the first
+  for (std::size_t k = 0; k <= n / 2; k += 2) fire(on_ring(k));
+  ASSERT_EQ(sys.burns().size(), n / 4 + 1);
+  for (const auto& b : sys.burns()) {
+    EXPECT_TRUE(b.adhered);
+    EXPECT_NEAR(b.diameter_mm, 0.4, 1e-9);
+  }
+  double arc = 0.0, half_arc = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double len = (ring.polyline_mm[k + 1] - ring.polyline_mm[k]).norm();
+    arc += len;
+    if (k < n / 2) half_arc += len;
+  }
+  // Reference: the half ring plus a spot radius beyond each end.
+  auto cov = find(m.criteria(), CriterionKind::kLaserCoverage);
+  EXPECT_NEAR(cov.value, (half_arc + 0.4) / arc, 0.05);
+  EXPECT_FALSE(cov.met);
+  EXPECT_EQ(m.totals().burns_on_target, n / 4 + 1);
+  EXPECT_EQ(m.totals().burns_elsewhere, 0u);
+  for (std::size_t k = n / 2 + 2; k < n; k += 2) fire(on_ring(k));
+  cov = find(m.criteria(), CriterionKind::kLaserCoverage);
+  EXPECT_GT(cov.value, 0.97);
+  EXPECT_TRUE(cov.met);
+  // A stray spot far from the ring counts as elsewhere.
+  fire(scene.eye.wall_point(40.0 * std::numbers::pi / 180.0, 150.0 * std::numbers::pi / 180.0));
+  EXPECT_EQ(m.totals().burns_elsewhere, 1u);
+  EXPECT_EQ(m.totals().count(InstrumentEventKind::kLaserBurn), sys.burns().size());
+}
+
+TEST(Criteria, DrainedRetinaFlatAndTimeLimit) {
+  Scene scene = build();
+  CaseProgress p(scene.world, MetricsCase::from_scene(scene));
+  p.evaluate(scene.world, nullptr, 0.0);
+  // The tear's flap stands off the wall: the same lift as the scene's own measure.
+  auto flat = find(p.criteria(), CriterionKind::kRetinaFlat);
+  EXPECT_EQ(flat.value, max_retina_lift_mm(scene));
+  EXPECT_GT(flat.value, 0.5);
+  EXPECT_FALSE(flat.met);
+
+  const std::uint32_t fluid = scene.detachment_forces[0];
+  ASSERT_TRUE(scene.world.set_local_force_scale(fluid, 0.5));
+  p.evaluate(scene.world, nullptr, 0.0);
+  auto drained = find(p.criteria(), CriterionKind::kDrained);
+  EXPECT_EQ(drained.value, 0.5);
+  EXPECT_NEAR(drained.progress, 0.5 / 0.95, 1e-12);
+  EXPECT_FALSE(drained.met);
+  ASSERT_TRUE(scene.world.set_local_force_scale(fluid, 0.0));
+
+  // Lay every free retina vertex on the wall.
+  Surface& rs = scene.world.surface(scene.retina);
+  const GlobeWall& wall = scene.world.wall();
+  for (std::uint32_t v = 0; v < rs.vertex_slots(); ++v) {
+    if (!rs.vertex_alive(v) || rs.is_fixed(v)) continue;
+    const Vec3 d = rs.position(v).normalized();
+    ASSERT_TRUE(rs.set_position(rs.vertex_id(v), d * wall.radius_toward(d)));
+  }
+  p.evaluate(scene.world, nullptr, 30.0);
+  flat = find(p.criteria(), CriterionKind::kRetinaFlat);
+  EXPECT_EQ(flat.value, max_retina_lift_mm(scene));
+  EXPECT_LT(flat.value, 0.3);
+  EXPECT_TRUE(flat.met);
+  EXPECT_EQ(flat.progress, 1.0);
+  drained = find(p.criteria(), CriterionKind::kDrained);
+  EXPECT_TRUE(drained.met);
+  EXPECT_EQ(drained.progress, 1.0);
+
+  auto time = find(p.criteria(), CriterionKind::kTimeLimit);
+  EXPECT_TRUE(time.met);
+  EXPECT_DOUBLE_EQ(time.progress, 0.5);  // half the time left
+  p.evaluate(scene.world, nullptr, 61.0);
+  time = find(p.criteria(), CriterionKind::kTimeLimit);
+  EXPECT_FALSE(time.met);
+  EXPECT_EQ(time.progress, 0.0);
+}
+
+TEST(Criteria, TargetsMustExistAndFitTheKind) {
+  Scene scene = build();
+  MetricsCase c = MetricsCase::from_scene(scene);
+  c.criteria = {{CriterionKind::kLaserCoverage, "line", 0.5}};  // a cut path is not a laser ring
+  EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);
+  c.criteria = {{CriterionKind::kDrained, "nowhere", 0.5}};
+  EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);
+  c.criteria = {{CriterionKind::kGelRemoved, "", 0.5}};  // this scene has no gel
+  EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);
+  ProgressOptions bad;
+  bad.path_tolerance_mm = 0.0;
+  c.criteria.clear();
+  EXPECT_THROW(CaseProgress(scene.world, c, bad), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace vitreo::core

@@ -1,0 +1,290 @@
+// SessionMetrics on scripted instruments: the odometer against the analytic length of the path,
+// retinal contacts against the script's known contact phases, refusals, determinism.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <tuple>
+
+#include "alloc_counter.hpp"
+#include "core/metrics/session_metrics.hpp"
+#include "test_meshes.hpp"
+
+namespace vitreo::core {
+namespace {
+
+constexpr double kDt = 1e-3;
+constexpr double kPi = std::numbers::pi;
+const Vec3 kPort(0.0, 0.0, 10.0);
+
+SurfaceDescription sheet(double size, int cells, double z) {
+  SurfaceDescription d;
+  d.mesh = test::rectangle(size, size, cells, cells);
+  for (auto& p : d.mesh.positions) p += Vec3(-size / 2, -size / 2, z);
+  d.contained_by_globe = false;
+  d.material.membrane_modulus_pa_mm = 1e5;  // stiff enough that the force grows with the depth
+  d.material.tear_strain = INFINITY;
+  return d;
+}
+
+// A flat "retina" (a sheet anchored at its border) under a port, and one blunt instrument.
+struct Bench {
+  TissueWorld world;
+  std::uint32_t retina = 0;
+  std::unique_ptr<InstrumentSystem> instruments;
+
+  explicit Bench(InstrumentKind kind = InstrumentKind::kDrainageNeedle, double sheet_z = 0.0)
+      : world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()) {
+    retina = world.add_surface(sheet(4.0, 16, sheet_z));
+    Surface& s = world.surface(retina);
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      const Vec3 p = s.rest_position(v);
+      if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) {
+        EXPECT_TRUE(s.set_fixed(s.vertex_id(v), true));
+      }
+    }
+    InstrumentSceneOptions o;
+    o.ports_mm = {kPort};
+    o.retina_surface = retina;
+    instruments = std::make_unique<InstrumentSystem>(world, o, std::vector<InstrumentDescription>{{kind, Gauge::k23, 0, {}}});
+    // The rig's measured eye rotation: none, so the eye frame is the fixture frame exactly.
+    instruments->set_eye_fixture_rotation(Quat::Identity());
+  }
+  MetricsCase metrics_case() const {
+    MetricsCase c;
+    c.retina = retina;
+    return c;
+  }
+  static Environment no_pressure() {
+    Environment e;
+    e.apply_pressure = false;
+    return e;
+  }
+  static SolverSettings no_sleep() {
+    SolverSettings s;
+    s.sleeping = false;
+    return s;
+  }
+  // Tip at p, the shaft through the port.
+  void step_at(const Vec3& p, bool present = true) {
+    InstrumentInput in;
+    in.tip_fixture_mm = p;
+    in.axis_fixture = (p - kPort).normalized();
+    in.present = present;
+    ASSERT_TRUE(instruments->set_input(0, in));
+    instruments->step(kDt);
+  }
+};
+
+void step_and_observe(Bench& b, SessionMetrics& m, const Vec3& p, bool present = true) {
+  b.step_at(p, present);
+  ASSERT_TRUE(m.observe(kDt));
+}
+
+TEST(SessionMetrics, OdometerMeasuresTheTipPathOfACircleAndNothingOutsideTheEye) {
+  Bench b(InstrumentKind::kPick, -11.0);
+  SessionMetrics m(b.world, b.metrics_case(), b.instruments.get());
+  const double r = 3.0;
+  const int n = 400;
+  const Vec3 c(0.0, 0.0, 2.0);
+  const auto on_circle = [&](int k) { return Vec3(c + r * Vec3(std::cos(2 * kPi * k / n), std::sin(2 * kPi * k / n), 0.0)); };
+  for (int k = 0; k <= n; ++k) step_and_observe(b, m, on_circle(k));
+  ASSERT_TRUE(b.instruments->instrument(0).inside);
+  // An inscribed n-gon: 2·n·r·sin(π/n), within r·π³/(3n²) of the circle's 2πr.
+  const double polygon = 2.0 * n * r * std::sin(kPi / n);
+  EXPECT_NEAR(m.instrument(0).path_length_mm, polygon, 1e-9);
+  EXPECT_NEAR(m.totals().path_length_mm, 2 * kPi * r, 2 * kPi * r * 2e-5);
+
+  // Out of the eye (not tracked), moved far away, back in at the start: the jumps are not path.
+  step_and_observe(b, m, Vec3(5.0, 5.0, 30.0), false);
+  EXPECT_FALSE(b.instruments->instrument(0).inside);
+  step_and_observe(b, m, Vec3(0.0, 0.0, 20.0), false);
+  for (int k = 0; k <= n; ++k) step_and_observe(b, m, on_circle(k));
+  EXPECT_NEAR(m.totals().path_length_mm, 2.0 * polygon, 1e-9);
+  EXPECT_EQ(m.totals().steps, static_cast<std::uint64_t>(2 * (n + 1) + 2));
+  EXPECT_NEAR(m.totals().elapsed_s, (2 * (n + 1) + 2) * kDt, 1e-12);
+  EXPECT_EQ(m.totals().retina_contacts, 0u);  // the sheet lies far below the circle
+}
+
+// Presses the sheet twice: `first` and `second` steps of contact at depth `depth`, apart.
+struct ContactScript {
+  int first = 200, second = 120;
+  double depth = 0.3;
+};
+
+void run_contacts(Bench& b, SessionMetrics& m, const ContactScript& s, double* impulse = nullptr, double* peak = nullptr) {
+  const Vec3 up(0.0, 0.0, 1.0), down(0.0, 0.0, -s.depth);
+  double sum = 0.0, max = 0.0;
+  const auto phase = [&](const Vec3& p, int steps) {
+    for (int i = 0; i < steps; ++i) {
+      step_and_observe(b, m, p);
+      sum += b.instruments->instrument(0).retina_force_un * kDt;
+      max = std::max(max, b.instruments->instrument(0).retina_force_un);
+    }
+  };
+  phase(up, 50);
+  phase(down, s.first);
+  phase(up, 100);
+  phase(down, s.second);
+  phase(up, 100);
+  if (impulse) *impulse = sum;
+  if (peak) *peak = max;
+}
+
+TEST(SessionMetrics, ScriptedContactsGiveTheirCountAndDuration) {
+  Bench b;
+  MetricsOptions o;
+  o.retina_force_limit_un = 1e9;  // no damage in this test
+  SessionMetrics m(b.world, b.metrics_case(), b.instruments.get(), o);
+  double impulse = 0.0, peak = 0.0;
+  const ContactScript s;
+  run_contacts(b, m, s, &impulse, &peak);
+  EXPECT_EQ(m.totals().retina_contacts, 2u);
+  // The tip jumps 1.3 mm in one step, far faster than the sheet can follow: each contact lasts as
+  // long as the script holds the tip down, to within a step at either end.
+  EXPECT_NEAR(m.totals().retina_contact_time_s, (s.first + s.second) * kDt, 2.5 * kDt);
+  EXPECT_EQ(m.instrument(0).retina_contacts, 2u);
+  EXPECT_GT(peak, 10.0);
+  EXPECT_DOUBLE_EQ(m.totals().peak_retina_force_un, peak);
+  EXPECT_NEAR(m.totals().retina_force_impulse_un_s, impulse, 1e-9 * impulse);
+  EXPECT_EQ(m.totals().time_over_force_limit_s, 0.0);
+  EXPECT_FALSE(m.instrument(0).touching_retina);
+}
+
+TEST(SessionMetrics, TimeAboveTheDamageLimitIsCounted) {
+  // A limit below the force of a held press (the sheet's tension on the tip, several hundred µN
+  // here): the time above it is the scripted contact time; the script's force trace, summed here,
+  // is the exact reference.
+  Bench b;
+  MetricsOptions o;
+  o.retina_force_limit_un = 300.0;
+  SessionMetrics m(b.world, b.metrics_case(), b.instruments.get(), o);
+  const ContactScript s;
+  const Vec3 up(0.0, 0.0, 1.0), down(0.0, 0.0, -s.depth);
+  int over = 0;
+  for (const auto& [p, steps] : {std::pair{up, 50}, {down, s.first}, {up, 100}, {down, s.second}, {up, 100}}) {
+    for (int i = 0; i < steps; ++i) {
+      step_and_observe(b, m, p);
+      if (b.instruments->instrument(0).retina_force_un > o.retina_force_limit_un) ++over;
+    }
+  }
+  EXPECT_DOUBLE_EQ(m.totals().time_over_force_limit_s, over * kDt);
+  EXPECT_NEAR(m.totals().time_over_force_limit_s, (s.first + s.second) * kDt, 2.5 * kDt);
+  EXPECT_EQ(m.totals().force_limit_un, 300.0);
+  // With the instruments' own limit (3000 µN) the same script never damages the sheet.
+  Bench b2;
+  SessionMetrics m2(b2.world, b2.metrics_case(), b2.instruments.get());
+  run_contacts(b2, m2, s);
+  EXPECT_EQ(m2.totals().force_limit_un, b2.instruments->options().retina_force_limit_un);
+  EXPECT_EQ(m2.totals().time_over_force_limit_s, 0.0);
+  EXPECT_EQ(m2.totals().count(InstrumentEventKind::kExcessiveRetinaForce), 0u);
+}
+
+TEST(SessionMetrics, RefusesBadDtAndASecondObserveOfTheSameStep) {
+  Bench b;
+  SessionMetrics m(b.world, b.metrics_case(), b.instruments.get());
+  // Before any step there is nothing to observe.
+  EXPECT_FALSE(m.observe(kDt));
+  b.step_at(Vec3(0, 0, 1));
+  EXPECT_FALSE(m.observe(0.0));
+  EXPECT_FALSE(m.observe(-kDt));
+  EXPECT_FALSE(m.observe(std::nan("")));
+  EXPECT_FALSE(m.observe(0.5));
+  EXPECT_EQ(m.totals().steps, 0u);
+  EXPECT_TRUE(m.observe(kDt));
+  EXPECT_FALSE(m.observe(kDt));
+  EXPECT_EQ(m.totals().steps, 1u);
+  EXPECT_DOUBLE_EQ(m.totals().elapsed_s, kDt);
+  MetricsOptions bad;
+  bad.contact_force_un = -1.0;
+  EXPECT_THROW(SessionMetrics(b.world, b.metrics_case(), b.instruments.get(), bad), InvalidArgument);
+  MetricsCase wrong = b.metrics_case();
+  wrong.criteria.push_back({CriterionKind::kMembraneRemoved, "none", 0.5});
+  EXPECT_THROW(SessionMetrics(b.world, wrong, b.instruments.get()), InvalidArgument);
+}
+
+TEST(SessionMetrics, ObserveCriteriaAndScoreDoNotAllocate) {
+  Bench b;
+  MetricsCase c = b.metrics_case();
+  c.criteria = {{CriterionKind::kRetinaFlat, "", 0.3}, {CriterionKind::kTimeLimit, "", 10.0}};
+  SessionMetrics m(b.world, c, b.instruments.get());
+  (void)m.score();
+  // The counter itself counts.
+  test::AllocationCounter::counting = true;
+  std::vector<double>* probe = new std::vector<double>(8);
+  test::AllocationCounter::counting = false;
+  delete probe;
+  ASSERT_EQ(test::AllocationCounter::allocations, 2);
+  test::AllocationCounter::allocations = 0;
+  for (int i = 0; i < 300; ++i) {
+    b.step_at(Vec3(0.0, 0.0, i % 100 < 50 ? 1.0 : -0.3));
+    test::AllocationCounter::counting = true;
+    const Status st = m.observe(kDt);
+    const ScoreCard& card = m.score();
+    test::AllocationCounter::counting = false;
+    ASSERT_TRUE(st);
+    ASSERT_EQ(card.categories.size(), 4u);
+  }
+  EXPECT_EQ(test::AllocationCounter::allocations, 0);
+  EXPECT_EQ(m.totals().retina_contacts, 3u);
+}
+
+TEST(SessionMetrics, SameSessionSameNumbers) {
+  const auto run = [] {
+    Bench b;
+    SessionMetrics m(b.world, b.metrics_case(), b.instruments.get());
+    run_contacts(b, m, ContactScript{});
+    const SessionTotals t = m.totals();
+    const ScoreCard s = m.score();
+    return std::make_tuple(t, s, b.world.state_hash());
+  };
+  const auto [ta, sa, ha] = run();
+  const auto [tb, sb, hb] = run();
+  EXPECT_EQ(ha, hb);
+  EXPECT_EQ(ta.path_length_mm, tb.path_length_mm);
+  EXPECT_EQ(ta.retina_force_impulse_un_s, tb.retina_force_impulse_un_s);
+  EXPECT_EQ(ta.peak_retina_force_un, tb.peak_retina_force_un);
+  EXPECT_EQ(ta.retina_contact_time_s, tb.retina_contact_time_s);
+  EXPECT_EQ(ta.events, tb.events);
+  ASSERT_EQ(sa.categories.size(), sb.categories.size());
+  for (std::size_t i = 0; i < sa.categories.size(); ++i) EXPECT_EQ(sa.categories[i].value, sb.categories[i].value);
+  EXPECT_EQ(sa.total, sb.total);
+}
+
+TEST(SessionMetrics, PressingLongerLowersTissueTreatmentAndLongerPathsLowerEfficiency) {
+  const auto session = [](int press_steps, int circles) {
+    Bench b;
+    SessionMetrics m(b.world, b.metrics_case(), b.instruments.get());
+    ContactScript s;
+    s.first = s.second = press_steps;
+    run_contacts(b, m, s);
+    for (int c = 0; c < circles; ++c) {
+      for (int k = 0; k <= 200; ++k) {
+        step_and_observe(b, m, Vec3(1.5 * std::cos(2 * kPi * k / 200), 1.5 * std::sin(2 * kPi * k / 200), 2.0));
+      }
+    }
+    return m.score();
+  };
+  const ScoreCard gentle = session(100, 1), rough = session(600, 1), wandering = session(100, 3);
+  const auto value = [](const ScoreCard& c, const char* name) {
+    const ScoreEntry* e = c.find(name);
+    EXPECT_NE(e, nullptr) << name;
+    return e ? e->value : -1.0;
+  };
+  EXPECT_LT(value(rough, "tissue_treatment"), value(gentle, "tissue_treatment"));
+  EXPECT_LT(value(wandering, "efficiency"), value(gentle, "efficiency"));
+  EXPECT_EQ(value(wandering, "tissue_treatment"), value(gentle, "tissue_treatment"));
+  for (const ScoreCard* c : {&gentle, &rough, &wandering}) {
+    for (const auto& e : c->categories) {
+      EXPECT_GE(e.value, 0.0);
+      EXPECT_LE(e.value, 100.0);
+    }
+    // No criteria: nothing to achieve, so no target_achievement; never a microscope score.
+    EXPECT_EQ(c->find("target_achievement"), nullptr);
+    EXPECT_EQ(c->find("microscope_handling"), nullptr);
+  }
+}
+
+}  // namespace
+}  // namespace vitreo::core
