@@ -205,8 +205,17 @@ class Surface {
   void wake_vertex(std::uint32_t v) {
     block_awake_[v / kSleepBlock] = 1;
     block_quiet_steps_[v / kSleepBlock] = 0;
+    ++block_motion_[v / kSleepBlock];
   }
   void wake_all();
+  // Motion counters for spatial indexes (core/topology/vertex_index.hpp): block b's counter
+  // changes whenever its vertices may have moved — it was woken (every call that moves, adds or
+  // changes a vertex wakes it) or it was awake during a step (note_awake_blocks_moved, called by
+  // the solver after each step). A block whose counter is unchanged has not moved, so an index
+  // only refits the blocks that did. Not part of the state: a restored snapshot bumps them all.
+  std::uint32_t block_motion(std::uint32_t b) const { return block_motion_[b]; }
+  void note_awake_blocks_moved();
+  void note_all_blocks_moved();
   // Called by the solver at the end of a step with each block's largest squared speed.
   void update_sleep(std::span<const double> block_max_speed2, double sleep_speed2, std::uint32_t steps_to_sleep);
   std::uint32_t awake_block_count() const;
@@ -280,6 +289,7 @@ class Surface {
   // Sleeping.
   std::vector<std::uint8_t> block_awake_;
   std::vector<std::uint16_t> block_quiet_steps_;
+  std::vector<std::uint32_t> block_motion_;  // see block_motion()
   std::uint64_t topology_version_ = 0;
   std::uint32_t line_springs_ = 0;
 };

@@ -36,6 +36,7 @@
 #include "core/common/status.hpp"
 #include "core/common/types.hpp"
 #include "core/tissue/surface.hpp"
+#include "core/topology/vertex_index.hpp"
 
 namespace vitreo::core {
 
@@ -89,6 +90,7 @@ class Cutter {
 
   Surface& surface_;
   CutSettings settings_;
+  VertexIndex index_;  // finds the vertices near the swept quad without visiting every slot
   double margin_mm_ = 0.0;  // how far beyond the swept box a crossing spring's ends may lie
   // Swept surface.
   std::array<std::array<Vec3, 3>, 2> swept_{};
@@ -108,6 +110,7 @@ class Cutter {
   std::vector<EdgeId> to_open_;
   std::vector<std::uint8_t> cut_degree_;
   std::vector<std::uint32_t> near_rim_, separated_;  // == stamp_: within the margin of the quad's boundary
+  std::vector<std::uint8_t> rim_mask_;  // where near_rim_ == stamp_: bit k, within the margin of rim_[k]
 };
 
 }  // namespace vitreo::core

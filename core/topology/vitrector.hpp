@@ -28,6 +28,7 @@
 #include "core/common/types.hpp"
 #include "core/tissue/external_forces.hpp"
 #include "core/tissue/surface.hpp"
+#include "core/topology/vertex_index.hpp"
 
 namespace vitreo::core {
 
@@ -79,6 +80,7 @@ class Vitrector {
 
   Surface& surface_;
   VitrectorSettings settings_;
+  VertexIndex index_;  // the field and the removal region visit only the vertices near the port
   Vec3 port_ = Vec3::Zero(), dir_ = Vec3::UnitZ();
   double vacuum_mmhg_ = 0.0, cut_rate_cpm_ = 0.0, cut_phase_ = 0.0;
   bool posed_ = false;
