@@ -567,7 +567,7 @@ Surface::TearResult Surface::tear_edge(EdgeId id) {
   return result;
 }
 
-std::uint32_t Surface::separate_fans(std::uint32_t v) {
+std::uint32_t Surface::separate_fans(std::uint32_t v, std::vector<std::uint32_t>* out) {
   // Collect v's triangles and group them into fans connected through edges incident to v.
   std::array<std::uint32_t, 64> tris{};
   std::array<std::uint8_t, 64> group{};
@@ -618,6 +618,7 @@ std::uint32_t Surface::separate_fans(std::uint32_t v) {
     if (free_vertices_.empty() && vertex_slots() >= x_.capacity()) break;  // pool full: leave as is
     ++copies;
     const std::uint32_t nv = allocate_vertex();
+    if (out && out->size() < out->capacity()) out->push_back(nv);
     x_[nv] = x_[v];
     v_[nv] = v_[v];
     rest_[nv] = rest_[v];

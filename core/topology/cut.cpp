@@ -17,9 +17,11 @@ void CutSettings::validate() const {
   require_range(min_piece_mm, 0.0, 1.0, "cut: min_piece_mm");
   require_range(min_blade_length_mm, 1e-9, 10.0, "cut: min_blade_length_mm");
   require_range(min_swept_area_mm2, 0.0, 10.0, "cut: min_swept_area_mm2");
+  quality.validate();
 }
 
-Cutter::Cutter(Surface& surface, CutSettings settings) : surface_(surface), settings_(settings), index_(surface) {
+Cutter::Cutter(Surface& surface, CutSettings settings)
+    : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality) {
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
   const std::size_t nt = ne;  // triangle capacity is below the spring capacity
@@ -368,13 +370,18 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     for (auto v : s.edge_vertices(id.index)) {
       if (!s.vertex_alive(v) || separated_[v] == stamp_) continue;  // once per vertex
       separated_[v] = stamp_;
-      r.vertices_added += s.separate_vertex_fans(s.vertex_id(v));
+      r.vertices_added += s.separate_vertex_fans(s.vertex_id(v), &on_cut_);  // copies join the cut
     }
   }
   r.vertices_added += r.end_points + r.springs_split;
   for (auto v : on_cut_) {
     if (s.vertex_alive(v)) s.wake_vertex(v);
   }
+  // Every triangle the cut made or changed has a vertex on the cut (or a copy of one).
+  const QualityResult q = quality_.clean_around(on_cut_);
+  r.collapsed = q.collapses;
+  r.unresolved = q.unresolved;
+  r.removed_mass_g = q.removed_mass_g;
   return r;
 }
 

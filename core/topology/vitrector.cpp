@@ -17,10 +17,11 @@ void VitrectorSettings::validate() const {
   require_range(min_piece_mm, 0.0, 1.0, "vitrector: min_piece_mm");
   require_range(max_vacuum_mmhg, 0.0, 760.0, "vitrector: max_vacuum_mmhg");
   require_range(max_cut_rate_cpm, 0.0, 1e5, "vitrector: max_cut_rate_cpm");
+  quality.validate();
 }
 
 Vitrector::Vitrector(Surface& surface, VitrectorSettings settings)
-    : surface_(surface), settings_(settings), index_(surface) {
+    : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality) {
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
   samples_.reserve(nv);
@@ -239,9 +240,16 @@ void Vitrector::remove(VitrectorStepResult& r) {
     r.removed_mass_g += removed.removed_mass_g;
   }
   // Bow-ties left by the removal: one vertex per fan (pools were checked for this above).
-  for (auto v : inside_) {
-    if (s.vertex_alive(v)) s.separate_vertex_fans(s.vertex_id(v));
+  const std::size_t n_inside = inside_.size();
+  for (std::size_t i = 0; i < n_inside; ++i) {
+    const std::uint32_t v = inside_[i];
+    if (s.vertex_alive(v)) s.separate_vertex_fans(s.vertex_id(v), &inside_);  // copies join the list
   }
+  // What is left of the inside vertices is the new boundary: every changed triangle touches it.
+  const QualityResult q = quality_.clean_around(inside_);
+  r.collapsed = q.collapses;
+  r.unresolved = q.unresolved;
+  r.removed_mass_g += q.removed_mass_g;  // lone sliver fragments left by the clipping
   removed_mass_g_ += r.removed_mass_g;
 }
 
