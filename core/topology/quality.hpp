@@ -22,9 +22,15 @@
 //  - Everything not removed keeps its handle; the removed vertex's handle goes stale (like
 //    removed material: an attachment on it breaks). Rest area and mass are exact (see
 //    Surface::collapse_edge): the removed triangles' rest area goes to their neighbours.
-//  - A poor triangle none of whose springs can be collapsed (all three refused) is counted in
-//    `unresolved` and left as is (simulated; XPBD keeps it stable). The tests assert it does not
-//    happen in their random operations.
+//  - A cap (apex almost on its longest spring) none of whose springs can be collapsed is flipped
+//    (split the longest spring at the apex's foot, collapse the foot into the apex) when both new
+//    triangles are above the limit.
+//  - Last resort: the sliver is merged into the neighbour across its longest spring
+//    (Surface::dissolve_triangle: its rest area moves there, mass exact; the surface opens along
+//    it); a lone one-triangle fragment is removed as material, its mass reported in
+//    QualityResult::removed_mass_g.
+//  - A poor triangle nothing can fix is counted in `unresolved` and left as is (simulated; XPBD
+//    keeps it stable). The property tests assert the floor after every one of their operations.
 //
 // No allocation after construction; visits only the triangles around the vertices it is given.
 #include <cstdint>
