@@ -396,6 +396,7 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       in.fixed_vec(f.block_awake_);
       in.fixed_vec(f.block_quiet_steps_);
       in.pod(f.topology_version_);
+      if (apply) f.note_all_blocks_moved();  // positions replaced: spatial indexes refit everything
 
       auto& sc = w.scratch_[i];
       in.fixed_vec(sc.previous);

@@ -144,6 +144,7 @@ void TissueWorld::finish_sleep() {
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     Surface& s = *surfaces_[si];
     Scratch& sc = scratch_[si];
+    s.note_awake_blocks_moved();  // before any falls asleep: they moved during this step
     if (settings_.sleeping) {
       s.update_sleep(sc.block_max_speed2, sleep2, static_cast<std::uint32_t>(settings_.sleep_after_steps));
     }

@@ -55,6 +55,7 @@ Surface::Surface(const SurfaceDescription& d)
            tri_alive_, tri_generation_, free_triangles_, next_corner_);
   block_awake_.assign((vcap + kSleepBlock - 1) / kSleepBlock, 1);
   block_quiet_steps_.assign(block_awake_.size(), 0);
+  block_motion_.assign(block_awake_.size(), 0);
 
   for (std::size_t i = 0; i < nv; ++i) {
     require_finite(mesh.positions[i], "surface '" + material_.name + "': vertex position");
@@ -409,6 +410,15 @@ void Surface::apply_plasticity(double dt_s) {
 void Surface::wake_all() {
   std::fill(block_awake_.begin(), block_awake_.end(), std::uint8_t{1});
   std::fill(block_quiet_steps_.begin(), block_quiet_steps_.end(), std::uint16_t{0});
+  note_all_blocks_moved();
+}
+
+void Surface::note_awake_blocks_moved() {
+  for (std::uint32_t b = 0; b < block_count(); ++b) block_motion_[b] += block_awake_[b];
+}
+
+void Surface::note_all_blocks_moved() {
+  for (auto& m : block_motion_) ++m;
 }
 
 void Surface::update_sleep(std::span<const double> block_max_speed2, double sleep_speed2, std::uint32_t steps_to_sleep) {
@@ -557,7 +567,7 @@ Surface::TearResult Surface::tear_edge(EdgeId id) {
   return result;
 }
 
-std::uint32_t Surface::separate_fans(std::uint32_t v) {
+std::uint32_t Surface::separate_fans(std::uint32_t v, std::vector<std::uint32_t>* out) {
   // Collect v's triangles and group them into fans connected through edges incident to v.
   std::array<std::uint32_t, 64> tris{};
   std::array<std::uint8_t, 64> group{};
@@ -608,6 +618,7 @@ std::uint32_t Surface::separate_fans(std::uint32_t v) {
     if (free_vertices_.empty() && vertex_slots() >= x_.capacity()) break;  // pool full: leave as is
     ++copies;
     const std::uint32_t nv = allocate_vertex();
+    if (out && out->size() < out->capacity()) out->push_back(nv);
     x_[nv] = x_[v];
     v_[nv] = v_[v];
     rest_[nv] = rest_[v];

@@ -177,7 +177,8 @@ class Surface {
   // Where v's triangles form several fans (after disconnect_edge or remove_triangle), every fan
   // after the first moves to a new copy of v (same position, velocity, rest position, fixed flag;
   // extra mass and attachments stay with v). Returns the number of copies made.
-  std::uint32_t separate_vertex_fans(VertexId v);
+  // When copies is given, the new vertices are appended to it (within its reserved capacity).
+  std::uint32_t separate_vertex_fans(VertexId v, std::vector<std::uint32_t>* copies = nullptr);
   struct RemoveResult {
     Status status = Status::ok();
     double removed_area_mm2 = 0.0;
@@ -189,6 +190,38 @@ class Surface {
   // unless separate_fans is false: a caller removing many triangles at once then calls
   // separate_vertex_fans on the corners itself, after the last one (check_surface fails until then).
   RemoveResult remove_triangle(TriangleId t, bool separate_fans = true);
+  // Collapses spring e into its end `keep` (mesh cleanup, core/topology/quality.hpp): the other
+  // end goes (its handle goes stale), the one or two triangles on e go, and in each of them the
+  // two springs to the opposite vertex become one (keep's). Rules: keep's position, rest position,
+  // fixed flag and handle stay; the removed vertex's extra mass moves to keep and keep takes the
+  // mass-weighted mean velocity (momentum kept); springs of the removed vertex are re-homed to keep
+  // with rest vectors by vector addition; the rest area of each removed triangle goes to the
+  // triangle across its removed spring (or, on a boundary, across the kept one), so rest area and
+  // mass stay exact. Refuses, changing nothing: a stale handle, keep not an end of e, a line
+  // spring or one without triangles, a removed vertex that is fixed (unless keep is too) or on the
+  // boundary while keep is not, an interior spring joining two boundary vertices (it would pinch
+  // the surface), the link condition failing (a vertex adjacent to both ends other than the
+  // opposite vertices: the result would not be manifold), a triangle that would flip or become
+  // degenerate (rest or current shape), or one whose smallest rest angle would fall below
+  // min_result_angle_rad.
+  struct CollapseResult {
+    Status status = Status::ok();
+    std::uint32_t removed_vertex = kNone;
+    std::uint32_t triangles_removed = 0;
+  };
+  // allow_pinch: collapse an interior spring between two boundary vertices anyway and give each
+  // fan of the kept vertex its own vertex afterwards (the surface parts there: for necks narrower
+  // than the minimum spring, which would tear at once).
+  CollapseResult collapse_edge(EdgeId e, std::uint32_t keep, double min_result_angle_rad = 0.0, bool allow_pinch = false);
+  // Merges triangle t into `receiver`, a triangle sharing a spring with it: t goes (springs left
+  // without a triangle go, bow-ties are separated) and its rest area is added to the receiver's,
+  // so mass stays exact; where t lay the surface opens (for slivers no collapse can remove).
+  // A corner with no other triangle goes with t. Refuses, changing nothing: stale handles,
+  // triangles that share no spring, such a corner being fixed or carrying extra mass, full pools.
+  Status dissolve_triangle(TriangleId t, TriangleId receiver);
+  // Smallest angle of triangle t measured on its springs' rest vectors (radians).
+  double triangle_min_rest_angle(std::uint32_t t) const;
+  bool is_boundary_vertex(std::uint32_t v) const;
   bool edge_is_line(std::uint32_t e) const { return edge_is_line_[e] != 0; }
   double edge_traction(std::uint32_t e) const { return edge_traction_[e]; }
 
@@ -205,8 +238,17 @@ class Surface {
   void wake_vertex(std::uint32_t v) {
     block_awake_[v / kSleepBlock] = 1;
     block_quiet_steps_[v / kSleepBlock] = 0;
+    ++block_motion_[v / kSleepBlock];
   }
   void wake_all();
+  // Motion counters for spatial indexes (core/topology/vertex_index.hpp): block b's counter
+  // changes whenever its vertices may have moved — it was woken (every call that moves, adds or
+  // changes a vertex wakes it) or it was awake during a step (note_awake_blocks_moved, called by
+  // the solver after each step). A block whose counter is unchanged has not moved, so an index
+  // only refits the blocks that did. Not part of the state: a restored snapshot bumps them all.
+  std::uint32_t block_motion(std::uint32_t b) const { return block_motion_[b]; }
+  void note_awake_blocks_moved();
+  void note_all_blocks_moved();
   // Called by the solver at the end of a step with each block's largest squared speed.
   void update_sleep(std::span<const double> block_max_speed2, double sleep_speed2, std::uint32_t steps_to_sleep);
   std::uint32_t awake_block_count() const;
@@ -241,7 +283,7 @@ class Surface {
   void attach_triangle_to_edge(std::uint32_t e, std::uint32_t t);
   void detach_triangle_from_edge(std::uint32_t e, std::uint32_t t);
   void refresh_rest(std::uint32_t e);
-  std::uint32_t separate_fans(std::uint32_t v);
+  std::uint32_t separate_fans(std::uint32_t v, std::vector<std::uint32_t>* copies = nullptr);
   void free_vertex(std::uint32_t v);
   void refresh_around(std::uint32_t v);
   // The spring's rest vector oriented from vertex `from` (which must be one of its ends).
@@ -280,6 +322,7 @@ class Surface {
   // Sleeping.
   std::vector<std::uint8_t> block_awake_;
   std::vector<std::uint16_t> block_quiet_steps_;
+  std::vector<std::uint32_t> block_motion_;  // see block_motion()
   std::uint64_t topology_version_ = 0;
   std::uint32_t line_springs_ = 0;
 };

@@ -220,9 +220,9 @@ Surface::DisconnectResult Surface::disconnect_edge(EdgeId id) {
   return r;
 }
 
-std::uint32_t Surface::separate_vertex_fans(VertexId id) {
+std::uint32_t Surface::separate_vertex_fans(VertexId id, std::vector<std::uint32_t>* copies) {
   if (!is_current(id)) return 0;
-  return separate_fans(id.index);
+  return separate_fans(id.index, copies);
 }
 
 Surface::RemoveResult Surface::remove_triangle(TriangleId id, bool separate) {
@@ -277,6 +277,266 @@ Surface::RemoveResult Surface::remove_triangle(TriangleId id, bool separate) {
     }
   }
   return r;
+}
+
+
+namespace {
+double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+// Smallest corner angle of a triangle given its three edge vectors d0 = v0→v1, d1 = v1→v2, d2 = v2→v0.
+double min_angle(const Vec3& d0, const Vec3& d1, const Vec3& d2) {
+  return std::min({angle_between(d0, -d2), angle_between(d1, -d0), angle_between(d2, -d1)});
+}
+}  // namespace
+
+Status Surface::dissolve_triangle(TriangleId id, TriangleId into) {
+  auto current = [&](TriangleId h) {
+    return h.index < triangle_slots() && tri_alive_[h.index] && tri_generation_[h.index] == h.generation;
+  };
+  if (!current(id) || !current(into) || id.index == into.index) {
+    return Status::error("dissolve_triangle: stale or invalid triangle handle");
+  }
+  const std::uint32_t t = id.index, u = into.index;
+  bool adjacent = false;
+  for (auto e : tri_e_[t]) adjacent = adjacent || edge_t_[e][0] == u || edge_t_[e][1] == u;
+  if (!adjacent) return Status::error("dissolve_triangle: the triangles share no spring");
+  for (auto v : tri_v_[t]) {
+    std::uint32_t n = 0;
+    for_each_triangle_of(v, [&](std::uint32_t, std::uint32_t) { ++n; });
+    // A corner with no other triangle goes with t; its area share moves with t's area, so only
+    // extra mass or an anchor would be lost.
+    if (n < 2 && (extra_mass_[v] != 0.0 || fixed_[v])) {
+      return Status::error("dissolve_triangle: a corner with extra mass or fixed has no other triangle");
+    }
+  }
+  if (!has_room(3, 0, 0)) return Status::error("dissolve_triangle: vertex pool full (raise the surface capacity)");
+  tri_rest_area_[u] += tri_rest_area_[t];
+  const auto removed = remove_triangle(id, true);
+  if (!removed.status) {  // cannot happen after the checks above; undo the transfer regardless
+    tri_rest_area_[u] -= tri_rest_area_[t];
+    return removed.status;
+  }
+  for (auto v : tri_v_[u]) refresh_around(v);
+  return Status::ok();
+}
+
+double Surface::triangle_min_rest_angle(std::uint32_t t) const {
+  const auto tv = tri_v_[t];
+  const auto te = tri_e_[t];
+  std::array<Vec3, 3> d;
+  for (std::uint32_t k = 0; k < 3; ++k) d[k] = edge_v_[te[k]][0] == tv[k] ? rest_vec_[te[k]] : Vec3(-rest_vec_[te[k]]);
+  return min_angle(d[0], d[1], d[2]);
+}
+
+bool Surface::is_boundary_vertex(std::uint32_t v) const {
+  bool boundary = false;
+  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+    for (auto e : tri_e_[t]) {
+      if ((edge_v_[e][0] == v || edge_v_[e][1] == v) && edge_t_[e][1] == kNone) boundary = true;
+    }
+  });
+  return boundary;
+}
+
+Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, double min_result_angle, bool allow_pinch) {
+  CollapseResult res;
+  auto refuse = [&](const char* why) {
+    res.status = Status::error(why);
+    return res;
+  };
+  if (!is_current(id)) return refuse("collapse_edge: stale or invalid edge handle");
+  const std::uint32_t e = id.index;
+  const auto ev = edge_v_[e];
+  if (k != ev[0] && k != ev[1]) return refuse("collapse_edge: keep is not an end of the spring");
+  if (edge_is_line_[e] || edge_t_[e][0] == kNone) return refuse("collapse_edge: only a triangle spring can be collapsed");
+  const std::uint32_t r = k == ev[0] ? ev[1] : ev[0];
+  if (fixed_[r] && !fixed_[k]) return refuse("collapse_edge: the removed vertex is fixed and the kept one is not");
+  const bool k_boundary = is_boundary_vertex(k), r_boundary = is_boundary_vertex(r);
+  if (r_boundary && !k_boundary) return refuse("collapse_edge: the removed vertex is on the boundary and the kept one is not");
+  const bool pinch = edge_t_[e][1] != kNone && k_boundary && r_boundary;
+  if (pinch && !allow_pinch) return refuse("collapse_edge: an interior spring between two boundary vertices (the surface would pinch)");
+  if (pinch && !has_room(2, 0, 0)) return refuse("collapse_edge: vertex pool full (raise the surface capacity)");
+  // The triangles on e, with their opposite vertex and the springs to it.
+  struct Wing {
+    std::uint32_t t = kNone, o = kNone, e_ko = kNone, e_ro = kNone, receiver = kNone;
+  };
+  std::array<Wing, 2> wings{};
+  std::uint32_t nwings = 0;
+  for (auto t : edge_t_[e]) {
+    if (t == kNone) continue;
+    Wing w;
+    w.t = t;
+    for (auto v : tri_v_[t]) {
+      if (v != k && v != r) w.o = v;
+    }
+    for (auto te : tri_e_[t]) {
+      const auto tv = edge_v_[te];
+      if (te == e) continue;
+      if (tv[0] == k || tv[1] == k) w.e_ko = te;
+      if (tv[0] == r || tv[1] == r) w.e_ro = te;
+    }
+    if (w.o == kNone || w.e_ko == kNone || w.e_ro == kNone) return refuse("collapse_edge: degenerate triangle on the spring");
+    nwings++;
+    wings[nwings - 1] = w;
+  }
+  auto other_triangle = [&](std::uint32_t edge, std::uint32_t t) {
+    const auto et = edge_t_[edge];
+    return et[0] == t ? et[1] : et[0];
+  };
+  for (std::uint32_t i = 0; i < nwings; ++i) {
+    Wing& w = wings[i];
+    const std::uint32_t across_r = other_triangle(w.e_ro, w.t), across_k = other_triangle(w.e_ko, w.t);
+    w.receiver = across_r != kNone ? across_r : across_k;
+    if (w.receiver == kNone) return refuse("collapse_edge: the triangle has no neighbour to take its area");
+    if (w.receiver == wings[0].t || w.receiver == wings[1].t) return refuse("collapse_edge: degenerate fan");
+  }
+  if (nwings == 2 && wings[0].o == wings[1].o) return refuse("collapse_edge: degenerate fan");
+  // The removed vertex's triangles (other than the wings) and its neighbours.
+  std::array<std::uint32_t, 64> fan{};
+  std::uint32_t nfan = 0;
+  bool overflow = false;
+  for_each_triangle_of(r, [&](std::uint32_t t, std::uint32_t) {
+    if (t == wings[0].t || t == wings[1].t) return;
+    if (nfan < fan.size()) {
+      fan[nfan++] = t;
+    } else {
+      overflow = true;
+    }
+  });
+  if (overflow) return refuse("collapse_edge: vertex of too high valence");
+  auto is_opposite = [&](std::uint32_t v) {
+    for (std::uint32_t i = 0; i < nwings; ++i) {
+      if (wings[i].o == v) return true;
+    }
+    return false;
+  };
+  // Link condition: a vertex adjacent to both ends must be an opposite vertex of e.
+  for (std::uint32_t i = 0; i < nfan; ++i) {
+    for (auto w : tri_v_[fan[i]]) {
+      if (w == k) return refuse("collapse_edge: a triangle other than the spring's joins both ends");
+      if (w == r || is_opposite(w)) continue;
+      if (find_edge(k, w) != kNone) return refuse("collapse_edge: link condition fails (the result would not be manifold)");
+    }
+  }
+  if (line_springs_ > 0) {
+    for (std::uint32_t f = 0; f < edge_slots(); ++f) {
+      if (!edge_alive_[f] || !edge_is_line_[f]) continue;
+      const auto fv = edge_v_[f];
+      if ((fv[0] == r && fv[1] == k) || (fv[0] == k && fv[1] == r)) return refuse("collapse_edge: a line spring joins both ends");
+    }
+  }
+  const Vec3 r_kr = oriented_rest(e, k);  // base rest vector from k to r
+  // Post-collapse rest vector (traction-scaled, as the solver sees it) of spring f from `from`.
+  auto scaled = [&](std::uint32_t f, const Vec3& base) { return Vec3(base * (surface_traction_ * edge_traction_[f])); };
+  auto merged_into = [&](std::uint32_t f) {
+    for (std::uint32_t i = 0; i < nwings; ++i) {
+      if (wings[i].e_ro == f) return wings[i].e_ko;
+    }
+    return kNone;
+  };
+  auto new_vector = [&](std::uint32_t f, std::uint32_t from) -> Vec3 {
+    const std::uint32_t m = merged_into(f);
+    if (m != kNone) {  // becomes keep's spring to the opposite vertex
+      const Vec3 ko = scaled(m, oriented_rest(m, k));
+      return from == r ? ko : Vec3(-ko);
+    }
+    const auto fv = edge_v_[f];
+    if (fv[0] != r && fv[1] != r) return scaled(f, oriented_rest(f, from));
+    const std::uint32_t w = fv[0] == r ? fv[1] : fv[0];
+    const Vec3 kw = scaled(f, r_kr + oriented_rest(f, r));
+    return from == w ? Vec3(-kw) : kw;
+  };
+  // No triangle of the fan may flip or degenerate, in the rest shape or the current one.
+  for (std::uint32_t i = 0; i < nfan; ++i) {
+    const std::uint32_t t = fan[i];
+    const auto tv = tri_v_[t];
+    const auto te = tri_e_[t];
+    std::array<Vec3, 3> d_old, d_new;
+    std::array<Vec3, 3> x_new;
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      d_old[c] = edge_v_[te[c]][0] == tv[c] ? rest_vec_[te[c]] : Vec3(-rest_vec_[te[c]]);
+      d_new[c] = new_vector(te[c], tv[c]);
+      x_new[c] = tv[c] == r ? x_[k] : x_[tv[c]];
+    }
+    const Vec3 n_old = d_old[0].cross(-d_old[2]), n_new = d_new[0].cross(-d_new[2]);
+    if (!(n_old.dot(n_new) > 0.0)) return refuse("collapse_edge: a triangle would flip in the rest shape");
+    if (min_angle(d_new[0], d_new[1], d_new[2]) < min_result_angle) {
+      return refuse("collapse_edge: a triangle would get a rest angle below the limit");
+    }
+    const Vec3 c_old = (x_[tv[1]] - x_[tv[0]]).cross(x_[tv[2]] - x_[tv[0]]);
+    const Vec3 c_new = (x_new[1] - x_new[0]).cross(x_new[2] - x_new[0]);
+    if (!(c_old.dot(c_new) > 0.0)) return refuse("collapse_edge: a triangle would flip in the current shape");
+  }
+
+  // ---- Apply (nothing below can fail) ----
+  ++topology_version_;
+  const double m_k = mass_[k], m_r = mass_[r];
+  if (m_k + m_r > 0.0) v_[k] = (m_k * v_[k] + m_r * v_[r]) / (m_k + m_r);
+  extra_mass_[k] += extra_mass_[r];
+  for (std::uint32_t i = 0; i < nwings; ++i) {
+    const Wing& w = wings[i];
+    tri_rest_area_[w.receiver] += tri_rest_area_[w.t];
+    free_triangle(w.t);
+    ++res.triangles_removed;
+  }
+  free_edge(e);
+  for (std::uint32_t i = 0; i < nwings; ++i) {
+    const Wing& w = wings[i];
+    // The triangle still on e_ro (at most one) moves to e_ko.
+    for (auto t : edge_t_[w.e_ro]) {
+      if (t == kNone) continue;
+      for (auto& te : tri_e_[t]) {
+        if (te == w.e_ro) te = w.e_ko;
+      }
+      attach_triangle_to_edge(w.e_ko, t);
+    }
+    free_edge(w.e_ro);
+  }
+  // Re-home the rest of r's fan and its springs onto k.
+  for (std::uint32_t i = 0; i < nfan; ++i) {
+    const std::uint32_t t = fan[i];
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      if (tri_v_[t][c] != r) continue;
+      unlink_corner(t, c);
+      tri_v_[t][c] = k;
+      link_corner(t, c);
+    }
+    for (auto f : tri_e_[t]) {
+      auto& fv = edge_v_[f];
+      if (fv[0] == r) {
+        fv[0] = k;
+        base_rest_vec_[f] = r_kr + base_rest_vec_[f];
+        refresh_rest(f);
+      } else if (fv[1] == r) {
+        fv[1] = k;
+        base_rest_vec_[f] = base_rest_vec_[f] - r_kr;
+        refresh_rest(f);
+      }
+    }
+  }
+  if (line_springs_ > 0) {
+    for (std::uint32_t f = 0; f < edge_slots(); ++f) {
+      if (!edge_alive_[f] || !edge_is_line_[f]) continue;
+      auto& fv = edge_v_[f];
+      if (fv[0] == r) {
+        fv[0] = k;
+        base_rest_vec_[f] = r_kr + base_rest_vec_[f];
+        refresh_rest(f);
+      } else if (fv[1] == r) {
+        fv[1] = k;
+        base_rest_vec_[f] = base_rest_vec_[f] - r_kr;
+        refresh_rest(f);
+      }
+    }
+  }
+  first_corner_[r] = kNone;
+  free_vertex(r);
+  refresh_around(k);
+  for (std::uint32_t i = 0; i < nwings; ++i) {
+    for (auto v : tri_v_[wings[i].receiver]) refresh_around(v);
+  }
+  if (pinch) separate_fans(k);
+  res.removed_vertex = r;
+  return res;
 }
 
 }  // namespace vitreo::core

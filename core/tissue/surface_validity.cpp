@@ -121,19 +121,22 @@ ValidityReport check_surface(const Surface& s, const ValidityLimits& limits) {
       fail("spring " + std::to_string(e) + " belongs to no triangle");
     }
   }
-  const double min_cos = std::cos(limits.min_rest_angle_deg * 3.14159265358979323846 / 180.0);
+  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+    if (s.edge_alive(e) && !s.edge_is_line(e) && !(s.edge_rest_length(e) >= limits.min_spring_rest_mm)) {
+      fail("spring " + std::to_string(e) + " rest length " + std::to_string(s.edge_rest_length(e)) + " mm below the limit");
+    }
+  }
+  const double min_angle = limits.min_rest_angle_deg * 3.14159265358979323846 / 180.0;
   for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
     if (!s.triangle_alive(t)) continue;
     if (s.triangle_rest_area(t) < limits.min_rest_area_mm2) {
       fail("triangle " + std::to_string(t) + " rest area " + std::to_string(s.triangle_rest_area(t)) + " below the limit");
     }
     if (limits.min_rest_angle_deg <= 0.0) continue;
-    const auto v = s.triangle_vertices(t);
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      const Vec3 a = s.rest_position(v[(k + 1) % 3]) - s.rest_position(v[k]);
-      const Vec3 b = s.rest_position(v[(k + 2) % 3]) - s.rest_position(v[k]);
-      const double c = a.dot(b) / (a.norm() * b.norm());
-      if (!(c <= min_cos)) fail("triangle " + std::to_string(t) + " has a rest angle below the limit");
+    const double angle = s.triangle_min_rest_angle(t);
+    if (!(angle >= min_angle)) {
+      fail("triangle " + std::to_string(t) + " rest angle " + std::to_string(angle * 180.0 / 3.14159265358979323846) +
+           "° below the limit");
     }
   }
   return r;

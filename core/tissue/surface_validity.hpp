@@ -21,15 +21,15 @@ struct ValidityReport {
 // rest areas are positive; positions and velocities are finite.
 ValidityReport check_surface(const Surface& surface);
 
-// Quality limits for meshes after topology changes (cuts, tears, removal). The cut and removal
-// code never splits a triangle into pieces smaller than snap_fraction of it, so tests can bound the
-// smallest rest area and angle relative to the mesh they started from.
+// Quality limits for meshes after topology changes (cuts, tears, removal): what the cleanup in
+// core/topology/quality.hpp guarantees (QualitySettings: min_spring, min_angle, min_area).
 struct ValidityLimits {
   double min_rest_area_mm2 = 0.0;
-  double min_rest_angle_deg = 0.0;  // measured on rest positions
+  double min_rest_angle_deg = 0.0;  // measured on the springs' rest vectors
+  double min_spring_rest_mm = 0.0;  // triangle springs
 };
 // check_surface plus: springs that are neither line springs nor edges of a triangle, triangles
-// below the limits.
+// and springs below the limits.
 ValidityReport check_surface(const Surface& surface, const ValidityLimits& limits);
 
 }  // namespace vitreo::core

@@ -75,6 +75,9 @@ CutResult Scissors::set_pose(const Vec3& pivot, const Vec3& bisector, const Vec3
       r.springs_opened += r2.springs_opened;
       r.vertices_added += r2.vertices_added;
       r.snapped += r2.snapped;
+      r.collapsed += r2.collapsed;
+      r.unresolved += r2.unresolved;
+      r.removed_mass_g += r2.removed_mass_g;
     }
   }
   has_last_ = true;

@@ -17,15 +17,18 @@ void CutSettings::validate() const {
   require_range(min_piece_mm, 0.0, 1.0, "cut: min_piece_mm");
   require_range(min_blade_length_mm, 1e-9, 10.0, "cut: min_blade_length_mm");
   require_range(min_swept_area_mm2, 0.0, 10.0, "cut: min_swept_area_mm2");
+  quality.validate();
 }
 
-Cutter::Cutter(Surface& surface, CutSettings settings) : surface_(surface), settings_(settings) {
+Cutter::Cutter(Surface& surface, CutSettings settings)
+    : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality) {
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
   const std::size_t nt = ne;  // triangle capacity is below the spring capacity
   cut_stamp_.assign(nv, 0);
   cut_degree_.assign(nv, 0);
   near_rim_.assign(nv, 0);
+  rim_mask_.assign(nv, 0);
   separated_.assign(nv, 0);
   edge_stamp_.assign(ne, 0);
   triangle_stamp_.assign(nt, 0);
@@ -63,16 +66,19 @@ void Cutter::mark(std::uint32_t v) {
 void Cutter::gather_candidates() {
   candidates_.clear();
   const Surface& s = surface_;
-  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-    if (!s.vertex_alive(v)) continue;
+  index_.for_each_in_box(box_lo_, box_hi_, [&](std::uint32_t v) {
     const Vec3& x = s.position(v);
-    if ((x.array() < box_lo_.array()).any() || (x.array() > box_hi_.array()).any()) continue;
-    if (!near_swept(x, margin_mm_)) continue;
+    if (!near_swept(x, margin_mm_)) return;
     candidates_.push_back(v);
-    for (const auto& seg : rim_) {
-      if (topology::distance_to_segment(x, seg[0], seg[1]) <= margin_mm_) near_rim_[v] = stamp_;
+    std::uint8_t mask = 0;
+    for (std::size_t k = 0; k < rim_.size(); ++k) {
+      if (topology::distance_to_segment(x, rim_[k][0], rim_[k][1]) <= margin_mm_) mask |= static_cast<std::uint8_t>(1u << k);
     }
-  }
+    if (mask != 0) {
+      near_rim_[v] = stamp_;
+      rim_mask_[v] = mask;
+    }
+  });
 }
 
 // Triangles and springs around the candidate vertices (deduplicated, in a fixed order).
@@ -141,29 +147,40 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   // Ends: the quad's boundary passing through the surface.
   const auto& boundary = rim_;
   std::array<Vec3, 32> ends{};
+  std::array<TriangleId, 32> end_triangle{};  // where each end was found
   std::uint32_t nends = 0;
-  auto add_end = [&](const Vec3& y) {
+  auto add_end = [&](const Vec3& y, std::uint32_t t) {
     bool known = false;
     for (std::uint32_t i = 0; i < nends; ++i) known = known || (ends[i] - y).norm() <= std::max(band, 1e-9);
-    if (!known && nends < ends.size()) ends[nends++] = y;
+    if (!known && nends < ends.size()) {
+      end_triangle[nends] = s.triangle_id(t);
+      ends[nends++] = y;
+    }
   };
+  auto rim_bits = [&](std::uint32_t v) { return near_rim_[v] == stamp_ ? rim_mask_[v] : std::uint8_t{0}; };
   for (auto t : triangles_) {
     const auto tv = s.triangle_vertices(t);
-    // Only triangles near the quad's boundary can hold an end.
-    if (near_rim_[tv[0]] != stamp_ && near_rim_[tv[1]] != stamp_ && near_rim_[tv[2]] != stamp_) continue;
-    for (const auto& seg : boundary) {
+    // Only triangles near the quad's boundary can hold an end; a rim segment can pass through a
+    // triangle only if all three corners lie within the margin of it (a corner is never farther
+    // from a point of its triangle than the triangle's longest edge).
+    const std::uint8_t any = rim_bits(tv[0]) | rim_bits(tv[1]) | rim_bits(tv[2]);
+    if (any == 0) continue;
+    const std::uint8_t all = rim_bits(tv[0]) & rim_bits(tv[1]) & rim_bits(tv[2]);
+    for (std::size_t k = 0; k < boundary.size(); ++k) {
+      if (!(all & (1u << k))) continue;
+      const auto& seg = boundary[k];
       if ((seg[1] - seg[0]).squaredNorm() < 1e-24) continue;
       double sp;
       std::array<double, 3> bary;
       if (!segment_triangle(seg[0], seg[1], s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), sp, bary)) continue;
-      add_end(seg[0] + sp * (seg[1] - seg[0]));
+      add_end(seg[0] + sp * (seg[1] - seg[0]), t);
     }
     // A corner of the quad resting on the triangle (within the band) ends the cut there too.
     for (const Vec3& c : {p0, q0, p1, q1}) {
       // Cheap rejection: a corner on the triangle lies within a spring's length of its corners.
       if ((c - s.position(tv[0])).squaredNorm() > margin_mm_ * margin_mm_) continue;
       const Vec3 y = closest_point_on_triangle(c, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]));
-      if ((y - c).norm() <= band) add_end(y);
+      if ((y - c).norm() <= band) add_end(y, t);
     }
   }
 
@@ -200,7 +217,15 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     const Vec3& y = ends[i];
     std::uint32_t best = kNone;
     double best_d2 = 1e-12;
+    // Usually the triangle it was found in is still there; otherwise (an earlier end split it)
+    // search the triangles near the cut, which include the pieces.
+    if (s.triangle_alive(end_triangle[i].index) && s.triangle_id(end_triangle[i].index) == end_triangle[i]) {
+      const auto tv = s.triangle_vertices(end_triangle[i].index);
+      const double d2 = (y - closest_point_on_triangle(y, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]))).squaredNorm();
+      if (d2 < best_d2) best = end_triangle[i].index;
+    }
     for (auto t : triangles_) {
+      if (best != kNone) break;
       if (!s.triangle_alive(t)) continue;
       const auto tv = s.triangle_vertices(t);
       const double d2 = (y - closest_point_on_triangle(y, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]))).squaredNorm();
@@ -345,13 +370,18 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     for (auto v : s.edge_vertices(id.index)) {
       if (!s.vertex_alive(v) || separated_[v] == stamp_) continue;  // once per vertex
       separated_[v] = stamp_;
-      r.vertices_added += s.separate_vertex_fans(s.vertex_id(v));
+      r.vertices_added += s.separate_vertex_fans(s.vertex_id(v), &on_cut_);  // copies join the cut
     }
   }
   r.vertices_added += r.end_points + r.springs_split;
   for (auto v : on_cut_) {
     if (s.vertex_alive(v)) s.wake_vertex(v);
   }
+  // Every triangle the cut made or changed has a vertex on the cut (or a copy of one).
+  const QualityResult q = quality_.clean_around(on_cut_);
+  r.collapsed = q.collapses;
+  r.unresolved = q.unresolved;
+  r.removed_mass_g = q.removed_mass_g;
   return r;
 }
 

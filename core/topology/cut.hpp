@@ -36,6 +36,8 @@
 #include "core/common/status.hpp"
 #include "core/common/types.hpp"
 #include "core/tissue/surface.hpp"
+#include "core/topology/quality.hpp"
+#include "core/topology/vertex_index.hpp"
 
 namespace vitreo::core {
 
@@ -53,6 +55,8 @@ struct CutSettings {
   double min_piece_mm = 0.005;
   double min_blade_length_mm = 1e-4;
   double min_swept_area_mm2 = 1e-10;
+  // Cleanup after each sweep (quality.hpp): slivers the existing geometry forces are collapsed.
+  QualitySettings quality;
   void validate() const;  // throws InvalidArgument
 };
 
@@ -63,6 +67,9 @@ struct CutResult {
   std::uint32_t springs_opened = 0;   // springs along the cut that were disconnected
   std::uint32_t vertices_added = 0;   // all new vertices (ends, crossings, copies)
   std::uint32_t snapped = 0;          // crossings moved onto a vertex (within the tolerance)
+  std::uint32_t collapsed = 0;        // slivers removed by the cleanup (quality.hpp)
+  std::uint32_t unresolved = 0;       // slivers the cleanup could not remove
+  double removed_mass_g = 0.0;        // lone sliver fragments the cleanup removed (exact)
 };
 
 class Cutter {
@@ -79,6 +86,8 @@ class Cutter {
   }
 
   const CutSettings& settings() const { return settings_; }
+  // Mass of the lone sliver fragments the cleanup removed over all sweeps (g).
+  double cleanup_removed_mass_g() const { return quality_.total_removed_mass_g(); }
   Surface& surface() { return surface_; }
 
  private:
@@ -89,6 +98,8 @@ class Cutter {
 
   Surface& surface_;
   CutSettings settings_;
+  VertexIndex index_;  // finds the vertices near the swept quad without visiting every slot
+  MeshQuality quality_;
   double margin_mm_ = 0.0;  // how far beyond the swept box a crossing spring's ends may lie
   // Swept surface.
   std::array<std::array<Vec3, 3>, 2> swept_{};
@@ -108,6 +119,7 @@ class Cutter {
   std::vector<EdgeId> to_open_;
   std::vector<std::uint8_t> cut_degree_;
   std::vector<std::uint32_t> near_rim_, separated_;  // == stamp_: within the margin of the quad's boundary
+  std::vector<std::uint8_t> rim_mask_;  // where near_rim_ == stamp_: bit k, within the margin of rim_[k]
 };
 
 }  // namespace vitreo::core

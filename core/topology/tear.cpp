@@ -5,7 +5,7 @@
 
 namespace vitreo::core {
 
-SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings) {
+SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings, MeshQuality* quality) {
   SpringTearResult r;
   if (!s.is_current(id)) {
     r.status = Status::error("tear_spring: stale or invalid spring handle");
@@ -28,12 +28,15 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
     r.status = Status::error("tear_spring: pools full (raise the surface capacity)");
     return r;
   }
+  // Every triangle the tear makes has one of these: the spring's ends, the split point, a tip.
+  std::array<std::uint32_t, 5> touched{s.edge_vertices(id.index)[0], s.edge_vertices(id.index)[1], kNone, kNone, kNone};
   const auto split = s.split_edge(id, settings.at);
   if (!split.status) {
     r.status = split.status;
     return r;
   }
   const std::uint32_t m = split.vertex;
+  touched[2] = m;
   ++r.vertices_added;
   // The springs from m to the opposite vertices are the new ones that are neither half of the
   // torn spring; a half ends at a former end of the spring, which lies on the spring's line.
@@ -79,6 +82,7 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
     const auto tip = s.split_edge(c, t);
     if (!tip.status) continue;
     ++r.vertices_added;
+    touched[static_cast<std::size_t>(3 + i)] = tip.vertex;
     const std::uint32_t e = s.find_edge(m, tip.vertex);
     if (e != kNone) open[static_cast<std::size_t>(nopen++)] = s.edge_id(e);
   }
@@ -86,11 +90,25 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
     const EdgeId e = open[static_cast<std::size_t>(i)];
     if (s.is_current(e) && s.edge_triangles(e.index)[1] != kNone) (void)s.disconnect_edge(e);
   }
-  r.vertices_added += s.separate_vertex_fans(s.vertex_id(m));
+  if (quality == nullptr) {
+    r.vertices_added += s.separate_vertex_fans(s.vertex_id(m));
+  } else {
+    auto& seeds = quality->seeds();
+    seeds.clear();
+    for (auto v : touched) {
+      if (v != kNone) seeds.push_back(v);
+    }
+    r.vertices_added += s.separate_vertex_fans(s.vertex_id(m), &seeds);  // m's copies too
+    const QualityResult q = quality->clean_around(seeds);
+    r.collapsed = q.collapses;
+    r.unresolved = q.unresolved;
+    r.removed_mass_g = q.removed_mass_g;
+  }
   return r;
 }
 
-std::uint32_t propagate_tears(Surface& s, double threshold, std::uint32_t max_tears, const TearSettings& settings) {
+std::uint32_t propagate_tears(Surface& s, double threshold, std::uint32_t max_tears, const TearSettings& settings,
+                              MeshQuality* quality) {
   std::uint32_t torn = 0;
   while (torn < max_tears) {
     std::uint32_t best = kNone;
@@ -104,7 +122,7 @@ std::uint32_t propagate_tears(Surface& s, double threshold, std::uint32_t max_te
       }
     }
     if (best == kNone) break;
-    if (!tear_spring(s, s.edge_id(best), settings).status) break;
+    if (!tear_spring(s, s.edge_id(best), settings, quality).status) break;
     ++torn;
   }
   return torn;

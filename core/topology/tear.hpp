@@ -15,6 +15,7 @@
 
 #include "core/common/status.hpp"
 #include "core/tissue/surface.hpp"
+#include "core/topology/quality.hpp"
 
 namespace vitreo::core {
 
@@ -31,13 +32,18 @@ struct TearSettings {
 struct SpringTearResult {
   Status status = Status::ok();
   std::uint32_t vertices_added = 0;
+  std::uint32_t collapsed = 0;   // slivers removed by the cleanup (with a MeshQuality)
+  std::uint32_t unresolved = 0;
+  double removed_mass_g = 0.0;  // lone sliver fragments the cleanup removed (exact)
 };
 
-SpringTearResult tear_spring(Surface& surface, EdgeId spring, const TearSettings& settings = {});
+// With a MeshQuality, the slivers the tear made are collapsed afterwards (quality.hpp).
+SpringTearResult tear_spring(Surface& surface, EdgeId spring, const TearSettings& settings = {},
+                             MeshQuality* quality = nullptr);
 
 // Tears, one at a time, the most strained triangle spring whose strain exceeds `strain_threshold`,
 // up to max_tears. Returns how many were torn. O(springs) per tear; meant for the step boundary.
 std::uint32_t propagate_tears(Surface& surface, double strain_threshold, std::uint32_t max_tears,
-                              const TearSettings& settings = {});
+                              const TearSettings& settings = {}, MeshQuality* quality = nullptr);
 
 }  // namespace vitreo::core

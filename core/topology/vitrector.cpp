@@ -17,9 +17,11 @@ void VitrectorSettings::validate() const {
   require_range(min_piece_mm, 0.0, 1.0, "vitrector: min_piece_mm");
   require_range(max_vacuum_mmhg, 0.0, 760.0, "vitrector: max_vacuum_mmhg");
   require_range(max_cut_rate_cpm, 0.0, 1e5, "vitrector: max_cut_rate_cpm");
+  quality.validate();
 }
 
-Vitrector::Vitrector(Surface& surface, VitrectorSettings settings) : surface_(surface), settings_(settings) {
+Vitrector::Vitrector(Surface& surface, VitrectorSettings settings)
+    : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality) {
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
   samples_.reserve(nv);
@@ -78,19 +80,19 @@ VitrectorStepResult Vitrector::apply(double dt) {
   const double drag = s.material().drag_pa_s_per_mm;
   const double k_leave = settings_.leaving_damping_per_s;
   samples_.clear();
-  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-    if (!s.vertex_alive(v) || s.is_fixed(v)) continue;
+  index_.for_each_in_box(Vec3(port_.array() - R), Vec3(port_.array() + R), [&](std::uint32_t v) {
+    if (s.is_fixed(v)) return;
     const Vec3 d = s.position(v) - port_;
     const double dist2 = d.squaredNorm();
-    if (dist2 >= R * R) continue;
+    if (dist2 >= R * R) return;
     const double dist = std::sqrt(dist2);
     const double along = d.dot(dir_);
-    if (along <= 0.0 || !(dist > 1e-9)) continue;  // behind the port, or at its centre
+    if (along <= 0.0 || !(dist > 1e-9)) return;  // behind the port, or at its centre
     const Vec3 toward = -d / dist;
     const double cos_angle = along / dist;
     const double falloff = (1.0 - dist / R) * (1.0 - dist / R);
     const double m = s.mass(v), area = s.vertex_rest_area(v);
-    if (!(m > 0.0)) continue;
+    if (!(m > 0.0)) return;
     const double c = drag * area / m;
     // Attraction under implicit drag: the speed it can add is bounded by the terminal speed.
     Vec3 a = toward * (p_port * cos_angle * falloff * area / m / (1.0 + dt * c));
@@ -98,7 +100,7 @@ VitrectorStepResult Vitrector::apply(double dt) {
     const double outward = -s.velocity(v).dot(toward);
     if (outward > 0.0 && k_leave > 0.0) a += toward * (outward * k_leave / (1.0 + dt * k_leave));
     samples_.push_back({v, a});
-  }
+  });
   r.attracted = static_cast<std::uint32_t>(samples_.size());
   if (p_port > 0.0 || k_leave > 0.0) r.status = apply_external_accelerations(s, samples_, dt);
   if (!r.status) return r;
@@ -130,16 +132,15 @@ void Vitrector::remove(VitrectorStepResult& r) {
   ++round_;
   inside_.clear();
   // Vertices inside (or on) the removal hemisphere; their region value is kept in phi_.
-  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-    if (!s.vertex_alive(v)) continue;
+  index_.for_each_in_box(Vec3(port_.array() - rr), Vec3(port_.array() + rr), [&](std::uint32_t v) {
     const Vec3 d = s.position(v) - port_;
-    if (d.squaredNorm() > rr * rr) continue;
+    if (d.squaredNorm() > rr * rr) return;
     const double phi = region(s.position(v));
-    if (phi > 0.0) continue;
+    if (phi > 0.0) return;
     stamp_[v] = round_;
     phi_[v] = phi;
     inside_.push_back(v);
-  }
+  });
   if (inside_.empty()) return;
   auto phi_of = [&](std::uint32_t v) { return stamp_[v] == round_ ? phi_[v] : region(s.position(v)); };
   auto gather = [&] {
@@ -239,9 +240,16 @@ void Vitrector::remove(VitrectorStepResult& r) {
     r.removed_mass_g += removed.removed_mass_g;
   }
   // Bow-ties left by the removal: one vertex per fan (pools were checked for this above).
-  for (auto v : inside_) {
-    if (s.vertex_alive(v)) s.separate_vertex_fans(s.vertex_id(v));
+  const std::size_t n_inside = inside_.size();
+  for (std::size_t i = 0; i < n_inside; ++i) {
+    const std::uint32_t v = inside_[i];
+    if (s.vertex_alive(v)) s.separate_vertex_fans(s.vertex_id(v), &inside_);  // copies join the list
   }
+  // What is left of the inside vertices is the new boundary: every changed triangle touches it.
+  const QualityResult q = quality_.clean_around(inside_);
+  r.collapsed = q.collapses;
+  r.unresolved = q.unresolved;
+  r.removed_mass_g += q.removed_mass_g;  // lone sliver fragments left by the clipping
   removed_mass_g_ += r.removed_mass_g;
 }
 

@@ -28,6 +28,8 @@
 #include "core/common/types.hpp"
 #include "core/tissue/external_forces.hpp"
 #include "core/tissue/surface.hpp"
+#include "core/topology/quality.hpp"
+#include "core/topology/vertex_index.hpp"
 
 namespace vitreo::core {
 
@@ -40,6 +42,7 @@ struct VitrectorSettings {
   double min_piece_mm = 0.005;  // crossings closer than this to a vertex snap onto it too
   double max_vacuum_mmhg = 650.0;
   double max_cut_rate_cpm = 10000.0;
+  QualitySettings quality;  // cleanup after each removal (quality.hpp)
   void validate() const;  // throws InvalidArgument
 };
 
@@ -52,6 +55,8 @@ struct VitrectorStepResult {
   std::uint32_t vertices_removed = 0;
   double removed_area_mm2 = 0.0;
   double removed_mass_g = 0.0;
+  std::uint32_t collapsed = 0;   // slivers removed by the cleanup
+  std::uint32_t unresolved = 0;  // slivers the cleanup could not remove
 };
 
 class Vitrector {
@@ -79,6 +84,8 @@ class Vitrector {
 
   Surface& surface_;
   VitrectorSettings settings_;
+  VertexIndex index_;  // the field and the removal region visit only the vertices near the port
+  MeshQuality quality_;
   Vec3 port_ = Vec3::Zero(), dir_ = Vec3::UnitZ();
   double vacuum_mmhg_ = 0.0, cut_rate_cpm_ = 0.0, cut_phase_ = 0.0;
   bool posed_ = false;

@@ -48,7 +48,7 @@ struct Fixture {
   explicit Fixture(double jitter = 0.0, unsigned seed = 1)
       : s(sheet(kW, kH, kCols, kRows, jitter, seed)), cutter(s), mass0(s.total_mass()), area0(s.total_rest_area()) {}
   void expect_valid_and_exact(const char* what) {
-    const auto report = check_surface(s, ValidityLimits{0.0, 0.0});
+    const auto report = check_surface(s, ValidityLimits{});
     EXPECT_TRUE(report.ok()) << what << ": " << report.summary();
     EXPECT_NEAR(s.total_mass(), mass0, 1e-12 * mass0) << what;
     EXPECT_NEAR(s.total_rest_area(), area0, 1e-12 * area0) << what;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "core/tissue/surface_validity.hpp"
 #include "core/tissue/tissue_world.hpp"
@@ -123,8 +124,35 @@ TEST(Vitrector, InvalidRequestsAreRefused) {
   EXPECT_FALSE(vit.set_vacuum(1e4));
   EXPECT_FALSE(vit.set_cut_rate(std::nan("")));
   ASSERT_TRUE(vit.set_pose(Vec3(1, 1, 1), Vec3(0, 0, -1)));
+  // Refused requests change nothing: no pose, vacuum or cut rate is taken, the sheet is untouched.
+  ASSERT_TRUE(vit.set_vacuum(300.0));
+  ASSERT_TRUE(vit.set_cut_rate(6000.0));
+  const auto version = s.topology_version();
+  const double mass = s.total_mass();
+  std::vector<Vec3> x, v;
+  for (std::uint32_t i = 0; i < s.vertex_slots(); ++i) {
+    x.push_back(s.position(i));
+    v.push_back(s.velocity(i));
+  }
   EXPECT_FALSE(vit.apply(0.0).status);
   EXPECT_FALSE(vit.apply(INFINITY).status);
+  EXPECT_FALSE(vit.apply(std::nan("")).status);
+  EXPECT_FALSE(vit.set_pose(Vec3(1, 1, INFINITY), Vec3(0, 0, -1)));
+  EXPECT_EQ(vit.port(), Vec3(1, 1, 1));
+  EXPECT_EQ(s.topology_version(), version);
+  EXPECT_EQ(s.total_mass(), mass);
+  for (std::uint32_t i = 0; i < s.vertex_slots(); ++i) {
+    EXPECT_EQ(s.position(i), x[i]);
+    EXPECT_EQ(s.velocity(i), v[i]);
+  }
+  // Tearing: a stale handle, a split parameter out of range, a line spring: refused, nothing changes.
+  const EdgeId e = s.edge_id(s.find_edge(20, 21));
+  TearSettings bad;
+  bad.at = 0.99;
+  EXPECT_FALSE(tear_spring(s, e, bad).status);
+  EXPECT_FALSE(tear_spring(s, EdgeId{e.index, e.generation + 1}).status);
+  EXPECT_EQ(s.topology_version(), version);
+  EXPECT_EQ(s.total_mass(), mass);
 }
 
 TEST(Tear, ACrackOpensAtTheStrainedSpringAndEndsInsideTheAdjacentTriangles) {
