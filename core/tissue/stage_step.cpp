@@ -244,6 +244,7 @@ StepReport TissueWorld::step(double dt_s) {
   const int substeps = settings_.substeps;
   const double h = dt_s / substeps;
   compute_external_accelerations(h);
+  pack_springs(h);
   bool finite = true;
   for (int sub = 0; sub < substeps && finite; ++sub) {
     integrate_and_predict(h);
@@ -256,7 +257,7 @@ StepReport TissueWorld::step(double dt_s) {
     }
     for (auto& at : attachments_) at.lambda = Vec3::Zero();
     for (int it = 0; it < settings_.iterations; ++it) {
-      for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, h, accumulate);
+      for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, accumulate);
       project_attachments(h, accumulate);
       const double fraction = static_cast<double>(sub + 1) / substeps;
       project_grips(h, fraction);

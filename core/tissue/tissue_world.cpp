@@ -71,6 +71,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.partners.assign(surface->edge_capacity() + blocks, 0);
   s.mark.assign(blocks, 0);
   s.group_active.assign(blocks, 1);
+  s.springs.resize(surface->edge_capacity());
   s.lambda_distance.resize(surface->edge_capacity());
   s.lambda_direction.resize(surface->edge_capacity());
   surfaces_.push_back(std::move(surface));

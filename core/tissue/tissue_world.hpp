@@ -243,6 +243,20 @@ class TissueWorld {
   struct LocalForce {
     LocalForceDescription d;
   };
+  // One spring as the sweep sees it during a step (built each step by pack_springs, in sweep
+  // order). Only springs with at least one movable end are packed.
+  struct SolverSpring {
+    std::uint32_t a, b;        // end vertices
+    std::uint32_t edge;        // for the multipliers of the accumulating (iterations > 1) sweep
+    std::uint32_t wake_block;  // 1 + the block of a sleeping end (the pull may wake it); 0: none
+    double wa, wb;             // effective inverse masses of the ends (constant within a step)
+    Vec3 rest_vec;
+    double rest_len;
+    double kh2;            // k h²
+    double kth;            // k τ h (the dashpot)
+    double denominator;    // (wa + wb)(k h² + k τ h) + 1: the distance term's XPBD denominator
+    double direction_gain; // the capped gain of the rest-direction term (single-iteration sweeps)
+  };
   struct Scratch {  // per surface, sized to capacity once
     std::vector<Vec3> previous, acceleration, rollback_x, rollback_v;
     std::vector<double> drag_rate;
@@ -268,6 +282,11 @@ class TissueWorld {
     std::vector<std::uint32_t> group_begin, group_edges, partner_begin, partners, mark;
     std::vector<std::uint8_t> group_active;
     std::uint64_t groups_version = ~std::uint64_t{0};
+    // The springs this step's sweeps project, in sweep order, with everything that is constant
+    // within a step gathered next to them (see pack_springs): the sweep reads one contiguous array
+    // instead of five edge arrays through an index, and skips no spring at run time.
+    std::vector<SolverSpring> springs;
+    std::uint32_t spring_count = 0;
     // Constraint multipliers accumulated over the iterations of one substep (only with
     // iterations > 1; a single iteration starts every constraint from zero).
     std::vector<double> lambda_distance;
@@ -282,7 +301,10 @@ class TissueWorld {
   // Stages of a step (one file each: stage_forces.cpp, stage_constraints.cpp, stage_step.cpp).
   void compute_external_accelerations(double h);
   void integrate_and_predict(double h);
-  void project_springs(std::uint32_t s, double h, bool accumulate);
+  void pack_springs(double h);
+  void project_springs(std::uint32_t s, bool accumulate);
+  template <bool kAccumulate, bool kDirection>
+  void sweep_springs(std::uint32_t s);
   void project_attachments(double h, bool accumulate);
   void project_wall();
   void project_grips(double h, double fraction);
