@@ -14,6 +14,7 @@ GlobeWall GlobeWall::sphere(const Vec3& center, double radius_mm) {
   GlobeWall w;
   w.center_ = center;
   w.radius_by_cos_.assign(kTableSize, radius_mm);
+  w.min_radius_ = radius_mm;
   return w;
 }
 
@@ -54,6 +55,7 @@ GlobeWall GlobeWall::from_profile(const Vec3& center, const std::vector<ProfileP
     const double u = std::abs(t1 - t0) > 1e-15 ? std::clamp((t - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
     w.radius_by_cos_[static_cast<std::size_t>(i)] = polar[j].second + u * (polar[j + 1].second - polar[j].second);
   }
+  w.min_radius_ = *std::min_element(w.radius_by_cos_.begin(), w.radius_by_cos_.end());
   return w;
 }
 
@@ -79,6 +81,8 @@ bool GlobeWall::project_inside(Vec3& p, double offset_mm) const {
   const double r2 = d.squaredNorm();
   const double n = std::sqrt(r2);
   if (!(n > 0.0)) return false;
+  // Well inside (the interpolated radius is never below the smallest tabulated one): no lookup.
+  if (n < min_radius_ - offset_mm) return false;
   const double limit = radius_at_cos(d.z() / n) - offset_mm;
   if (n <= limit) return false;
   p = center_ + d * (limit / n);

@@ -25,6 +25,8 @@ class GlobeWall {
   const Vec3& center() const { return center_; }
   // Wall radius in the direction d (need not be normalised, must be non-zero).
   double radius_toward(const Vec3& d) const;
+  // The same when |d| is already known (n = d.norm()).
+  double radius_toward(const Vec3& d, double n) const { return radius_at_cos(n > 0.0 ? d.z() / n : 1.0); }
   // Signed distance along the ray from the centre: > 0 inside the wall.
   double clearance(const Vec3& p) const;
   // Moves p back onto the wall (minus `offset_mm`) along the ray from the centre if it lies beyond.
@@ -37,6 +39,7 @@ class GlobeWall {
 
   Vec3 center_ = Vec3::Zero();
   std::vector<double> radius_by_cos_;  // index i ↔ cos θ = -1 + 2i/(kTableSize-1)
+  double min_radius_ = 0.0;            // smallest table radius: nothing nearer the centre is outside
 };
 
 }  // namespace vitreo::core

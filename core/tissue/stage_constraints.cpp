@@ -19,12 +19,12 @@ namespace {
 constexpr double kAttachmentWake_mm = 5e-3;
 // See the direction term in project_springs.
 constexpr double kMaxDirectionFraction = 0.25;
+
 }  // namespace
 
 // Once per step, after the effective masses are known: everything a spring's projection needs
 // that does not change between substeps and iterations, packed in sweep order. Springs whose ends
 // are both immovable this step (asleep, anchored, dead) are left out; they would change nothing.
-// The expressions are those of the sweep itself, so packing changes no bit of the result.
 void TissueWorld::pack_springs(double h) {
   const double h2 = h * h;
   for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
@@ -49,9 +49,19 @@ void TissueWorld::pack_springs(double h) {
       sp.b = b;
       sp.edge = e;
       sp.wake_block = 0;
+      sp.wake_length = 0.0;
       if (wa == 0.0 || wb == 0.0) {
         const std::uint32_t still = wa == 0.0 ? a : b;
-        if (!s.vertex_awake(still)) sp.wake_block = still / Surface::kSleepBlock + 1;
+        if (!s.vertex_awake(still)) {
+          const std::uint32_t block = still / Surface::kSleepBlock;
+          sp.wake_block = block + 1;
+          const std::uint64_t key = (std::uint64_t{block} << 32) | sc.block_sleep_serial[block];
+          if (sc.wake_key[e] != key) {  // first step with this sleep of that block
+            sc.wake_key[e] = key;
+            sc.wake_length[e] = (view.x[b] - view.x[a]).norm();
+          }
+          sp.wake_length = sc.wake_length[e];
+        }
       }
       sp.wa = wa;
       sp.wb = wb;
@@ -59,7 +69,7 @@ void TissueWorld::pack_springs(double h) {
       sp.rest_len = rl[e];
       sp.kh2 = k[e] * h2;
       sp.kth = k[e] * tau_h;
-      sp.denominator = ws * (sp.kh2 + sp.kth) + 1.0;
+      sp.inverse_denominator = 1.0 / (ws * (sp.kh2 + sp.kth) + 1.0);
       const double kvh2 = ratio * sp.kh2;
       sp.direction_gain = std::min(kvh2 / (ws * kvh2 + 1.0), kMaxDirectionFraction / ws);
     });
@@ -126,19 +136,23 @@ void TissueWorld::sweep_springs(std::uint32_t si) {
     const double len = d.norm();
     if (!(len > 0.0)) continue;
     const double c = len - sp.rest_len;
-    // A spring from an awake vertex pulling hard on a sleeping one wakes it for the next step.
-    if (sp.wake_block != 0 && std::abs(c) > wake_strain * sp.rest_len) wake[sp.wake_block - 1] = 1;
+    // A spring from an awake vertex whose pull on a sleeping one has changed wakes it for the
+    // next step.
+    if (sp.wake_block != 0 && std::abs(len - sp.wake_length) > wake_strain * sp.rest_len) wake[sp.wake_block - 1] = 1;
     // Dashpot β = τ k: with γ = β/(k h), XPBD's damped update multiplied through by k h² becomes
     // Δλ = −(k h² C + τ k h · ∇C·Δx) / (Σw (k h² + τ k h) + 1), Δx the motion in this substep.
-    const double rate = sp.kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) / len : 0.0;
+    // One division per spring (1/len; the denominator's inverse is packed): divisions and the
+    // square root are what the projection waits on.
+    const double inv_len = 1.0 / len;
+    const double rate = sp.kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) * inv_len : 0.0;
     double dl = -c * sp.kh2 - sp.kth * rate;
     if constexpr (kAccumulate) {
-      dl = (dl - lam[sp.edge]) / sp.denominator;
+      dl = (dl - lam[sp.edge]) * sp.inverse_denominator;
       lam[sp.edge] += dl;
     } else {
-      dl /= sp.denominator;
+      dl *= sp.inverse_denominator;
     }
-    const Vec3 corr = d * (dl / len);
+    const Vec3 corr = d * (dl * inv_len);
     x[a] -= wa * corr;
     x[b] += wb * corr;
   }
