@@ -15,6 +15,7 @@ GlobeWall GlobeWall::sphere(const Vec3& center, double radius_mm) {
   w.center_ = center;
   w.radius_by_cos_.assign(kTableSize, radius_mm);
   w.min_radius_ = radius_mm;
+  w.spherical_ = true;
   return w;
 }
 
@@ -67,26 +68,12 @@ double GlobeWall::radius_at_cos(double c) const {
 }
 
 double GlobeWall::radius_toward(const Vec3& d) const {
-  const double n = d.norm();
-  return radius_at_cos(n > 0.0 ? d.z() / n : 1.0);
+  return radius_toward(d, d.norm());
 }
 
 double GlobeWall::clearance(const Vec3& p) const {
   const Vec3 d = p - center_;
   return radius_toward(d) - d.norm();
-}
-
-bool GlobeWall::project_inside(Vec3& p, double offset_mm) const {
-  const Vec3 d = p - center_;
-  const double r2 = d.squaredNorm();
-  const double n = std::sqrt(r2);
-  if (!(n > 0.0)) return false;
-  // Well inside (the interpolated radius is never below the smallest tabulated one): no lookup.
-  if (n < min_radius_ - offset_mm) return false;
-  const double limit = radius_at_cos(d.z() / n) - offset_mm;
-  if (n <= limit) return false;
-  p = center_ + d * (limit / n);
-  return true;
 }
 
 }  // namespace vitreo::core

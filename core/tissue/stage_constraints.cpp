@@ -133,7 +133,8 @@ void TissueWorld::sweep_springs(std::uint32_t si) {
     }
 
     // Distance term: C = |d| − L.
-    const double len = d.norm();
+    const double len2 = d.squaredNorm();
+    const double len = std::sqrt(len2);
     if (!(len > 0.0)) continue;
     const double c = len - sp.rest_len;
     // A spring from an awake vertex whose pull on a sleeping one has changed wakes it for the
@@ -141,9 +142,10 @@ void TissueWorld::sweep_springs(std::uint32_t si) {
     if (sp.wake_block != 0 && std::abs(len - sp.wake_length) > wake_strain * sp.rest_len) wake[sp.wake_block - 1] = 1;
     // Dashpot β = τ k: with γ = β/(k h), XPBD's damped update multiplied through by k h² becomes
     // Δλ = −(k h² C + τ k h · ∇C·Δx) / (Σw (k h² + τ k h) + 1), Δx the motion in this substep.
-    // One division per spring (1/len; the denominator's inverse is packed): divisions and the
-    // square root are what the projection waits on.
-    const double inv_len = 1.0 / len;
+    // One division per spring (the denominator's inverse is packed), and 1/len as len/len², so
+    // the division runs beside the square root instead of after it: the sweep is a chain of
+    // dependent projections, and their latency is its cost.
+    const double inv_len = len * (1.0 / len2);
     const double rate = sp.kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) * inv_len : 0.0;
     double dl = -c * sp.kh2 - sp.kth * rate;
     if constexpr (kAccumulate) {

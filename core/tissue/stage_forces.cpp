@@ -116,18 +116,21 @@ void TissueWorld::compute_external_accelerations(double h) {
       }
       // Inertia = own mass + entrained fluid (none under gas); weight acts on the own mass only.
       const bool in_gas = any_gas && view.x[v].z() > env.fluid_level_z_mm;
-      const double own_mass = 1.0 / view.inverse_mass[v];
+      // (Divisions are the cost of this loop: each reciprocal is taken once and multiplied.)
+      const double own_mass = s.mass(v);
       const double inertia = own_mass + (in_gas ? 0.0 : added_per_area * view.vertex_area[v]);
-      sc.drag_rate[v] = drag * view.vertex_area[v] / inertia + settling_damping;
-      sc.effective_inverse_mass[v] = 1.0 / (inertia * (1.0 + h * sc.drag_rate[v]));
+      const double inverse_inertia = 1.0 / inertia;
+      sc.drag_rate[v] = drag * view.vertex_area[v] * inverse_inertia + settling_damping;
       sc.velocity_keep[v] = 1.0 / (1.0 + h * sc.drag_rate[v]);
+      sc.effective_inverse_mass[v] = inverse_inertia * sc.velocity_keep[v];
       const Vec3& g = in_gas ? g_gas : g_fluid;
       const Vec3 radial = view.x[v] - wall_.center();
       const double r = radial.norm();
+      const double inverse_r = 1.0 / r;
       if (pressurised && r > 0.0) {
-        sc.acceleration[v] += radial * (env.intraocular_pressure_pa * sc.current_area[v] / r);
+        sc.acceleration[v] += radial * (env.intraocular_pressure_pa * sc.current_area[v] * inverse_r);
       }
-      Vec3 a = (sc.acceleration[v] + own_mass * g) / inertia;
+      Vec3 a = (sc.acceleration[v] + own_mass * g) * inverse_inertia;
       sc.contact_load[v] = 0.0;
       if (walled && r > 0.0) {
         // Resting contact: where tissue lies on the wall and is pushed into it (intraocular
@@ -144,7 +147,7 @@ void TissueWorld::compute_external_accelerations(double h) {
         // them back, and they flipped between the two every step at ~5 mm/s, never resting.
         const double clearance = wall_.radius_toward(radial, r) - r - settings_.wall_offset_mm;
         const double engaged = std::clamp(1.0 - clearance / kContactBand_mm, 0.0, 1.0);
-        const Vec3 normal = radial / r;
+        const Vec3 normal = radial * inverse_r;
         const double an = a.dot(normal);
         if (engaged > 0.0 && an > 0.0) {
           const double reaction = engaged * an;

@@ -86,7 +86,8 @@ bool TissueWorld::update_velocities(double h) {
       view.v[v] = (view.x[v] - sc.previous[v]) * inv_h;
       if (sc.wall_touched[v]) {
         sc.wall_touched[v] = 0;
-        const Vec3 normal = (view.x[v] - wall_.center()).normalized();
+        const Vec3 radial = view.x[v] - wall_.center();
+        const Vec3 normal = radial * (1.0 / radial.norm());  // touched: on the wall, never at the centre
         const double vn = view.v[v].dot(normal);
         if (vn > 0.0) view.v[v] -= vn * normal;
       }
