@@ -19,7 +19,7 @@
 
 namespace vitreo::core {
 
-inline constexpr std::uint32_t kSnapshotVersion = 1;
+inline constexpr std::uint32_t kSnapshotVersion = 2;  // 2: the solver's wake lengths
 
 struct SnapshotInfo {
   std::uint32_t version = 0;

@@ -254,6 +254,9 @@ void WorldAccess::write_state(const TissueWorld& w, std::vector<std::uint8_t>& o
     o.vec(sc.block_was_awake);
     o.vec(sc.wake_request);
     o.vec(sc.block_max_speed2);
+    o.vec(sc.block_sleep_serial);
+    o.vec(sc.wake_key);
+    o.vec(sc.wake_length);
     o.vec(sc.group_begin);
     o.vec(sc.group_edges);
     o.vec(sc.partner_begin);
@@ -411,6 +414,9 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       in.fixed_vec(sc.block_was_awake);
       in.fixed_vec(sc.wake_request);
       in.fixed_vec(sc.block_max_speed2);
+      in.fixed_vec(sc.block_sleep_serial);
+      in.fixed_vec(sc.wake_key);
+      in.fixed_vec(sc.wake_length);
       in.fixed_vec(sc.group_begin);
       in.fixed_vec(sc.group_edges);
       in.fixed_vec(sc.partner_begin);

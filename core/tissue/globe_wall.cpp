@@ -14,6 +14,8 @@ GlobeWall GlobeWall::sphere(const Vec3& center, double radius_mm) {
   GlobeWall w;
   w.center_ = center;
   w.radius_by_cos_.assign(kTableSize, radius_mm);
+  w.min_radius_ = radius_mm;
+  w.spherical_ = true;
   return w;
 }
 
@@ -54,6 +56,7 @@ GlobeWall GlobeWall::from_profile(const Vec3& center, const std::vector<ProfileP
     const double u = std::abs(t1 - t0) > 1e-15 ? std::clamp((t - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
     w.radius_by_cos_[static_cast<std::size_t>(i)] = polar[j].second + u * (polar[j + 1].second - polar[j].second);
   }
+  w.min_radius_ = *std::min_element(w.radius_by_cos_.begin(), w.radius_by_cos_.end());
   return w;
 }
 
@@ -65,24 +68,12 @@ double GlobeWall::radius_at_cos(double c) const {
 }
 
 double GlobeWall::radius_toward(const Vec3& d) const {
-  const double n = d.norm();
-  return radius_at_cos(n > 0.0 ? d.z() / n : 1.0);
+  return radius_toward(d, d.norm());
 }
 
 double GlobeWall::clearance(const Vec3& p) const {
   const Vec3 d = p - center_;
   return radius_toward(d) - d.norm();
-}
-
-bool GlobeWall::project_inside(Vec3& p, double offset_mm) const {
-  const Vec3 d = p - center_;
-  const double r2 = d.squaredNorm();
-  const double n = std::sqrt(r2);
-  if (!(n > 0.0)) return false;
-  const double limit = radius_at_cos(d.z() / n) - offset_mm;
-  if (n <= limit) return false;
-  p = center_ + d * (limit / n);
-  return true;
 }
 
 }  // namespace vitreo::core

@@ -7,6 +7,7 @@
 // +z (anterior) axis, tabulated finely from the anatomical profile and interpolated in cos θ, which
 // costs a square root and a table lookup per vertex.
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "core/common/types.hpp"
@@ -25,11 +26,25 @@ class GlobeWall {
   const Vec3& center() const { return center_; }
   // Wall radius in the direction d (need not be normalised, must be non-zero).
   double radius_toward(const Vec3& d) const;
+  // The same when |d| is already known (n = d.norm()).
+  double radius_toward(const Vec3& d, double n) const {
+    return spherical_ ? min_radius_ : radius_at_cos(n > 0.0 ? d.z() / n : 1.0);
+  }
   // Signed distance along the ray from the centre: > 0 inside the wall.
   double clearance(const Vec3& p) const;
   // Moves p back onto the wall (minus `offset_mm`) along the ray from the centre if it lies beyond.
   // Returns true if p was moved.
-  bool project_inside(Vec3& p, double offset_mm) const;
+  bool project_inside(Vec3& p, double offset_mm) const {  // inline: called per vertex and substep
+    const Vec3 d = p - center_;
+    const double n = std::sqrt(d.squaredNorm());
+    if (!(n > 0.0)) return false;
+    // Well inside (the interpolated radius is never below the smallest tabulated one): no lookup.
+    if (n < min_radius_ - offset_mm) return false;
+    const double limit = (spherical_ ? min_radius_ : radius_at_cos(d.z() / n)) - offset_mm;
+    if (n <= limit) return false;
+    p = center_ + d * (limit / n);
+    return true;
+  }
 
  private:
   static constexpr int kTableSize = 2049;
@@ -37,6 +52,8 @@ class GlobeWall {
 
   Vec3 center_ = Vec3::Zero();
   std::vector<double> radius_by_cos_;  // index i ↔ cos θ = -1 + 2i/(kTableSize-1)
+  double min_radius_ = 0.0;            // smallest table radius: nothing nearer the centre is outside
+  bool spherical_ = false;             // every radius is min_radius_ (no lookup needed)
 };
 
 }  // namespace vitreo::core

@@ -19,49 +19,113 @@ namespace {
 constexpr double kAttachmentWake_mm = 5e-3;
 // See the direction term in project_springs.
 constexpr double kMaxDirectionFraction = 0.25;
+
 }  // namespace
 
-void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
-  Surface& s = *surfaces_[si];
-  auto view = s.solver_view();
+// Once per step, after the effective masses are known: everything a spring's projection needs
+// that does not change between substeps and iterations, packed in sweep order. Springs whose ends
+// are both immovable this step (asleep, anchored, dead) are left out; they would change nothing.
+void TissueWorld::pack_springs(double h) {
   const double h2 = h * h;
-  const double ratio = s.material().direction_stiffness_ratio;
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
+    Surface& s = *surfaces_[si];
+    Scratch& sc = scratch_[si];
+    auto view = s.solver_view();
+    const double ratio = s.material().direction_stiffness_ratio;
+    const double tau_h = s.material().internal_damping_s * h;
+    const double* w = sc.effective_inverse_mass.data();
+    const auto* ev = view.edge_v.data();
+    const Vec3* rv = view.rest_vec.data();
+    const double* rl = view.rest_len.data();
+    const double* k = view.stiffness.data();
+    SolverSpring* out = sc.springs.data();
+    std::uint32_t n = 0;
+    for_each_active_edge(si, [&](std::uint32_t e) {
+      const std::uint32_t a = ev[e][0], b = ev[e][1];
+      const double wa = w[a], wb = w[b], ws = wa + wb;
+      if (ws == 0.0) return;
+      SolverSpring& sp = out[n++];
+      sp.a = a;
+      sp.b = b;
+      sp.edge = e;
+      sp.wake_block = 0;
+      sp.wake_length = 0.0;
+      if (wa == 0.0 || wb == 0.0) {
+        const std::uint32_t still = wa == 0.0 ? a : b;
+        if (!s.vertex_awake(still)) {
+          const std::uint32_t block = still / Surface::kSleepBlock;
+          sp.wake_block = block + 1;
+          const std::uint64_t key = (std::uint64_t{block} << 32) | sc.block_sleep_serial[block];
+          if (sc.wake_key[e] != key) {  // first step with this sleep of that block
+            sc.wake_key[e] = key;
+            sc.wake_length[e] = (view.x[b] - view.x[a]).norm();
+          }
+          sp.wake_length = sc.wake_length[e];
+        }
+      }
+      sp.wa = wa;
+      sp.wb = wb;
+      sp.rest_vec = rv[e];
+      sp.rest_len = rl[e];
+      sp.kh2 = k[e] * h2;
+      sp.kth = k[e] * tau_h;
+      sp.inverse_denominator = 1.0 / (ws * (sp.kh2 + sp.kth) + 1.0);
+      const double kvh2 = ratio * sp.kh2;
+      sp.direction_gain = std::min(kvh2 / (ws * kvh2 + 1.0), kMaxDirectionFraction / ws);
+    });
+    sc.spring_count = n;
+  }
+}
 
-  Vec3* x = view.x.data();
-  const double* w = scratch_[si].effective_inverse_mass.data();
-  const Vec3* prev = scratch_[si].previous.data();
-  // Dashpot β = τ k: with γ = β/(k h), XPBD's damped update multiplied through by k h² becomes
-  // Δλ = −(k h² C + τ k h · ∇C·Δx) / (Σw (k h² + τ k h) + 1), Δx the motion in this substep.
-  const double tau_h = s.material().internal_damping_s * h;
-  const auto* ev = view.edge_v.data();
-  const Vec3* rv = view.rest_vec.data();
-  const double* rl = view.rest_len.data();
-  const double* k = view.stiffness.data();
-  double* lam = scratch_[si].lambda_distance.data();
-  Vec3* lam_dir = scratch_[si].lambda_direction.data();
+void TissueWorld::project_springs(std::uint32_t si, bool accumulate) {
+  const bool direction = surfaces_[si]->material().direction_stiffness_ratio > 0.0;
+  if (accumulate) {
+    if (direction) {
+      sweep_springs<true, true>(si);
+    } else {
+      sweep_springs<true, false>(si);
+    }
+  } else if (direction) {
+    sweep_springs<false, true>(si);
+  } else {
+    sweep_springs<false, false>(si);
+  }
+}
 
-  std::uint8_t* wake = scratch_[si].wake_request.data();
+template <bool kAccumulate, bool kDirection>
+void TissueWorld::sweep_springs(std::uint32_t si) {
+  Surface& s = *surfaces_[si];
+  Scratch& sc = scratch_[si];
+  [[maybe_unused]] const double ratio = s.material().direction_stiffness_ratio;
+  Vec3* x = s.solver_view().x.data();
+  const Vec3* prev = sc.previous.data();
+  [[maybe_unused]] double* lam = sc.lambda_distance.data();
+  [[maybe_unused]] Vec3* lam_dir = sc.lambda_direction.data();
+  std::uint8_t* wake = sc.wake_request.data();
   const double wake_strain = settings_.wake_strain;
-  for_each_active_edge(si, [&](std::uint32_t e) {
-    const std::uint32_t a = ev[e][0], b = ev[e][1];
-    const double wa = w[a], wb = w[b], ws = wa + wb;
-    if (ws == 0.0) return;
+  const SolverSpring* springs = sc.springs.data();
+  const std::uint32_t n = sc.spring_count;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const SolverSpring& sp = springs[i];
+    const std::uint32_t a = sp.a, b = sp.b;
+    const double wa = sp.wa, wb = sp.wb;
     Vec3 d = x[b] - x[a];
-    const double kh2 = k[e] * h2;
 
     // The vector spring's rest-direction term (thesis eq. 2.1): C = d − r, a 3-vector constraint.
-    if (ratio > 0.0) {
+    if constexpr (kDirection) {
       // It is a gentle shape memory, not a structural constraint: where it would be stiff for the
       // substep (k h² w ≫ 1, stiff membranes on a fine mesh) it is capped to remove at most
-      // kMaxDirectionFraction of its violation per substep. Uncapped, a rigid world-frame direction
-      // term fights the length and wall constraints and makes stiff membranes jitter.
-      const double kvh2 = ratio * kh2;
-      Vec3 dl = (rv[e] - d);
-      if (accumulate) {
-        dl = (dl * kvh2 - lam_dir[e]) / (ws * kvh2 + 1.0);
-        lam_dir[e] += dl;
+      // kMaxDirectionFraction of its violation per substep (direction_gain, see pack_springs).
+      // Uncapped, a rigid world-frame direction term fights the length and wall constraints and
+      // makes stiff membranes jitter.
+      const double ws = wa + wb;
+      Vec3 dl = (sp.rest_vec - d);
+      if constexpr (kAccumulate) {
+        const double kvh2 = ratio * sp.kh2;
+        dl = (dl * kvh2 - lam_dir[sp.edge]) / (ws * kvh2 + 1.0);
+        lam_dir[sp.edge] += dl;
       } else {
-        dl *= std::min(kvh2 / (ws * kvh2 + 1.0), kMaxDirectionFraction / ws);
+        dl *= sp.direction_gain;
       }
       x[a] -= wa * dl;
       x[b] += wb * dl;
@@ -69,27 +133,31 @@ void TissueWorld::project_springs(std::uint32_t si, double h, bool accumulate) {
     }
 
     // Distance term: C = |d| − L.
-    const double len = d.norm();
-    if (!(len > 0.0)) return;
-    const double c = len - rl[e];
-    // A spring from an awake vertex pulling hard on a sleeping one wakes it for the next step.
-    if ((wa == 0.0 || wb == 0.0) && std::abs(c) > wake_strain * rl[e]) {
-      const std::uint32_t still = wa == 0.0 ? a : b;
-      if (!s.vertex_awake(still)) wake[still / Surface::kSleepBlock] = 1;
-    }
-    const double kth = k[e] * tau_h;
-    const double rate = kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) / len : 0.0;
-    double dl = -c * kh2 - kth * rate;
-    if (accumulate) {
-      dl = (dl - lam[e]) / (ws * (kh2 + kth) + 1.0);
-      lam[e] += dl;
+    const double len2 = d.squaredNorm();
+    const double len = std::sqrt(len2);
+    if (!(len > 0.0)) continue;
+    const double c = len - sp.rest_len;
+    // A spring from an awake vertex whose pull on a sleeping one has changed wakes it for the
+    // next step.
+    if (sp.wake_block != 0 && std::abs(len - sp.wake_length) > wake_strain * sp.rest_len) wake[sp.wake_block - 1] = 1;
+    // Dashpot β = τ k: with γ = β/(k h), XPBD's damped update multiplied through by k h² becomes
+    // Δλ = −(k h² C + τ k h · ∇C·Δx) / (Σw (k h² + τ k h) + 1), Δx the motion in this substep.
+    // One division per spring (the denominator's inverse is packed), and 1/len as len/len², so
+    // the division runs beside the square root instead of after it: the sweep is a chain of
+    // dependent projections, and their latency is its cost.
+    const double inv_len = len * (1.0 / len2);
+    const double rate = sp.kth > 0.0 ? d.dot((x[b] - prev[b]) - (x[a] - prev[a])) * inv_len : 0.0;
+    double dl = -c * sp.kh2 - sp.kth * rate;
+    if constexpr (kAccumulate) {
+      dl = (dl - lam[sp.edge]) * sp.inverse_denominator;
+      lam[sp.edge] += dl;
     } else {
-      dl /= ws * (kh2 + kth) + 1.0;
+      dl *= sp.inverse_denominator;
     }
-    const Vec3 corr = d * (dl / len);
+    const Vec3 corr = d * (dl * inv_len);
     x[a] -= wa * corr;
     x[b] += wb * corr;
-  });
+  }
 }
 
 void TissueWorld::project_attachments(double h, bool accumulate) {

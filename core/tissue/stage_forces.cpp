@@ -34,6 +34,7 @@ void TissueWorld::compute_external_accelerations(double h) {
     for (std::uint32_t b = 0; b < s.block_count(); ++b) {
       const bool awake = s.block_awake(b);
       if (!awake && sc.block_was_awake[b]) {
+        ++sc.block_sleep_serial[b];  // its springs' wake lengths are taken afresh (pack_springs)
         const std::uint32_t end = std::min(n, (b + 1) * Surface::kSleepBlock);
         for (std::uint32_t v = b * Surface::kSleepBlock; v < end; ++v) {
           sc.effective_inverse_mass[v] = 0.0;
@@ -55,11 +56,16 @@ void TissueWorld::compute_external_accelerations(double h) {
     // the normal pressure; tests/core check it against Laplace's law.)
     const bool pressurised = s.pressurised() && env.apply_pressure && env.intraocular_pressure_pa > 0.0;
     if (pressurised) {
+      const std::uint64_t epoch = ++sc.area_epoch;
       for_each_awake_vertex(s, [&](std::uint32_t v) {
         double area = 0.0;
         s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
-          const auto [a, b, c] = view.tri_v[t];
-          area += (view.x[b] - view.x[a]).cross(view.x[c] - view.x[a]).norm();
+          if (sc.triangle_epoch[t] != epoch) {  // each triangle once, not once per corner
+            sc.triangle_epoch[t] = epoch;
+            const auto [a, b, c] = view.tri_v[t];
+            sc.triangle_area2[t] = (view.x[b] - view.x[a]).cross(view.x[c] - view.x[a]).norm();
+          }
+          area += sc.triangle_area2[t];
         });
         sc.current_area[v] = area / 6.0;
       });
@@ -104,33 +110,44 @@ void TissueWorld::compute_external_accelerations(double h) {
         sc.acceleration[v] = Vec3::Zero();
         sc.effective_inverse_mass[v] = 0.0;
         sc.drag_rate[v] = 0.0;
+        sc.velocity_keep[v] = 1.0;
         sc.contact_load[v] = 0.0;
         return;
       }
       // Inertia = own mass + entrained fluid (none under gas); weight acts on the own mass only.
       const bool in_gas = any_gas && view.x[v].z() > env.fluid_level_z_mm;
-      const double own_mass = 1.0 / view.inverse_mass[v];
+      // (Divisions are the cost of this loop: each reciprocal is taken once and multiplied.)
+      const double own_mass = s.mass(v);
       const double inertia = own_mass + (in_gas ? 0.0 : added_per_area * view.vertex_area[v]);
-      sc.drag_rate[v] = drag * view.vertex_area[v] / inertia + settling_damping;
-      sc.effective_inverse_mass[v] = 1.0 / (inertia * (1.0 + h * sc.drag_rate[v]));
+      const double inverse_inertia = 1.0 / inertia;
+      sc.drag_rate[v] = drag * view.vertex_area[v] * inverse_inertia + settling_damping;
+      sc.velocity_keep[v] = 1.0 / (1.0 + h * sc.drag_rate[v]);
+      sc.effective_inverse_mass[v] = inverse_inertia * sc.velocity_keep[v];
       const Vec3& g = in_gas ? g_gas : g_fluid;
       const Vec3 radial = view.x[v] - wall_.center();
       const double r = radial.norm();
+      const double inverse_r = 1.0 / r;
       if (pressurised && r > 0.0) {
-        sc.acceleration[v] += radial * (env.intraocular_pressure_pa * sc.current_area[v] / r);
+        sc.acceleration[v] += radial * (env.intraocular_pressure_pa * sc.current_area[v] * inverse_r);
       }
-      Vec3 a = (sc.acceleration[v] + own_mass * g) / inertia;
+      Vec3 a = (sc.acceleration[v] + own_mass * g) * inverse_inertia;
       sc.contact_load[v] = 0.0;
       if (walled && r > 0.0) {
         // Resting contact: where tissue lies on the wall and is pushed into it (intraocular
-        // pressure on the attached retina), the wall pushes back with the normal load and friction
-        // holds the tangential part. Without this the light retina would be flung into the wall
-        // and projected back every substep. The reaction fades in over the last kContactBand_mm
-        // before the wall, so a vertex near the edge of a detachment settles at a small clearance
-        // instead of switching between "touching" and "free" from one step to the next.
-        const double clearance = wall_.radius_toward(radial) - r - settings_.wall_offset_mm;
+        // pressure on the attached retina), friction holds the tangential part up to μ times the
+        // normal load, fading in over the last kContactBand_mm before the wall.
+        //
+        // The normal load itself stays in the acceleration: the wall takes it as a constraint
+        // when the prediction reaches it (integrate_and_predict stops the predicted position on
+        // the wall, before the springs see it), so the wall pushes back exactly as hard as the
+        // springs leave it to, never more. Removing the normal load here instead (an explicit
+        // reaction fading over a micrometre) made a stiff penalty spring — the load of ~10⁶ mm/s²
+        // over 1 µm — that one-step substeps cannot integrate: where a detachment meets the
+        // attached retina the springs lifted vertices off the unloaded wall, the full load slammed
+        // them back, and they flipped between the two every step at ~5 mm/s, never resting.
+        const double clearance = wall_.radius_toward(radial, r) - r - settings_.wall_offset_mm;
         const double engaged = std::clamp(1.0 - clearance / kContactBand_mm, 0.0, 1.0);
-        const Vec3 normal = radial / r;
+        const Vec3 normal = radial * inverse_r;
         const double an = a.dot(normal);
         if (engaged > 0.0 && an > 0.0) {
           const double reaction = engaged * an;
@@ -138,8 +155,8 @@ void TissueWorld::compute_external_accelerations(double h) {
           const double at_norm = at.norm();
           const double friction = mu * reaction;
           at *= at_norm > friction ? 1.0 - friction / at_norm : 0.0;
-          a = at + (an - reaction) * normal;
-          sc.contact_load[v] = reaction;  // the wall's normal reaction, per unit inertia
+          a = at + an * normal;
+          sc.contact_load[v] = reaction;  // the wall's normal load, per unit inertia
         }
       }
       sc.acceleration[v] = a;

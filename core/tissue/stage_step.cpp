@@ -40,17 +40,20 @@ void TissueWorld::restore_rollback() {
 }
 
 void TissueWorld::integrate_and_predict(double h) {
+  const double offset = settings_.wall_offset_mm;
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     const Surface& s = *surfaces_[si];
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
+    const bool walled = s.contained_by_globe();
     for_each_awake_vertex(s, [&](std::uint32_t v) {
       sc.previous[v] = view.x[v];
       if (view.inverse_mass[v] == 0.0) return;
       if (sc.contact_load[v] > 0.0) {
         // Lying on the wall: no velocity into it (an inelastic contact), and Coulomb friction
         // takes up to μ·load·h of the sliding speed each substep, so attached retina stays put.
-        const Vec3 normal = (view.x[v] - wall_.center()).normalized();
+        const Vec3 radial = view.x[v] - wall_.center();
+        const Vec3 normal = radial * (1.0 / radial.norm());
         const double vn = view.v[v].dot(normal);
         if (vn > 0.0) view.v[v] -= vn * normal;
         const double vt = view.v[v].norm();
@@ -60,8 +63,12 @@ void TissueWorld::integrate_and_predict(double h) {
       // Implicit Euler with drag: (m + h c) v' = m v + h f, i.e. v' = (v + h a) / (1 + h c/m). It
       // damps any rate without reversing the velocity and gives the right terminal speed; the
       // constraints then use the matching effective mass (see Scratch::effective_inverse_mass).
-      view.v[v] = (view.v[v] + h * sc.acceleration[v]) / (1.0 + h * sc.drag_rate[v]);
+      view.v[v] = (view.v[v] + h * sc.acceleration[v]) * sc.velocity_keep[v];
       view.x[v] += h * view.v[v];
+      // A prediction through the wall stops on it (an inelastic contact, like the wall
+      // projection after the springs): the springs then work from where the tissue can be, and
+      // the pressure that pressed it there is taken by the wall (see compute_external_accelerations).
+      if (walled && wall_.project_inside(view.x[v], offset)) sc.wall_touched[v] = 1;
     });
   }
 }
@@ -79,7 +86,8 @@ bool TissueWorld::update_velocities(double h) {
       view.v[v] = (view.x[v] - sc.previous[v]) * inv_h;
       if (sc.wall_touched[v]) {
         sc.wall_touched[v] = 0;
-        const Vec3 normal = (view.x[v] - wall_.center()).normalized();
+        const Vec3 radial = view.x[v] - wall_.center();
+        const Vec3 normal = radial * (1.0 / radial.norm());  // touched: on the wall, never at the centre
         const double vn = view.v[v].dot(normal);
         if (vn > 0.0) view.v[v] -= vn * normal;
       }
@@ -245,6 +253,7 @@ StepReport TissueWorld::step(double dt_s) {
   const int substeps = settings_.substeps;
   const double h = dt_s / substeps;
   compute_external_accelerations(h);
+  pack_springs(h);
   bool finite = true;
   for (int sub = 0; sub < substeps && finite; ++sub) {
     integrate_and_predict(h);
@@ -257,7 +266,7 @@ StepReport TissueWorld::step(double dt_s) {
     }
     for (auto& at : attachments_) at.lambda = Vec3::Zero();
     for (int it = 0; it < settings_.iterations; ++it) {
-      for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, h, accumulate);
+      for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, accumulate);
       project_attachments(h, accumulate);
       const double fraction = static_cast<double>(sub + 1) / substeps;
       project_grips(h, fraction);

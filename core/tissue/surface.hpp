@@ -113,6 +113,7 @@ class Surface {
   // ---- Triangles -----------------------------------------------------------------------------
   std::uint32_t triangle_slots() const { return static_cast<std::uint32_t>(tri_alive_.size()); }
   std::uint32_t triangle_count() const { return live_triangles_; }
+  std::uint32_t triangle_capacity() const { return static_cast<std::uint32_t>(tri_v_.capacity()); }
   bool triangle_alive(std::uint32_t t) const { return t < triangle_slots() && tri_alive_[t] != 0; }
   TriangleId triangle_id(std::uint32_t t) const { return {t, tri_generation_[t]}; }
   std::array<std::uint32_t, 3> triangle_vertices(std::uint32_t t) const { return tri_v_[t]; }

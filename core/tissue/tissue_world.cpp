@@ -57,6 +57,9 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.rollback_x.resize(cap);
   s.rollback_v.resize(cap);
   s.drag_rate.resize(cap);
+  s.velocity_keep.resize(cap);
+  s.triangle_area2.resize(surface->triangle_capacity());
+  s.triangle_epoch.assign(surface->triangle_capacity(), 0);
   s.effective_inverse_mass.resize(cap);
   s.current_area.resize(cap);
   s.contact_load.resize(cap);
@@ -65,12 +68,16 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.block_was_awake.assign(blocks, 0);
   s.wake_request.assign(blocks, 0);
   s.block_max_speed2.assign(blocks, 0.0);
+  s.block_sleep_serial.assign(blocks, 0);
+  s.wake_key.assign(surface->edge_capacity(), ~std::uint64_t{0});
+  s.wake_length.assign(surface->edge_capacity(), 0.0);
   s.group_begin.assign(blocks + 1, 0);
   s.group_edges.assign(surface->edge_capacity(), 0);
   s.partner_begin.assign(blocks + 1, 0);
   s.partners.assign(surface->edge_capacity() + blocks, 0);
   s.mark.assign(blocks, 0);
   s.group_active.assign(blocks, 1);
+  s.springs.resize(surface->edge_capacity());
   s.lambda_distance.resize(surface->edge_capacity());
   s.lambda_direction.resize(surface->edge_capacity());
   surfaces_.push_back(std::move(surface));

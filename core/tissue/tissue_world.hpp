@@ -55,7 +55,8 @@ struct SolverSettings {
   bool sleeping = true;
   double sleep_speed_mm_s = 0.2;
   int sleep_after_steps = 200;
-  // A sleeping vertex wakes when an awake neighbour's spring to it is strained by more than this.
+  // A sleeping vertex wakes when the strain of a spring from an awake neighbour has changed by more
+  // than this since its block fell asleep (a change of pull, not the tension it rests under).
   double wake_strain = 0.01;
   // Friction between tissue and the globe wall (retina on the pigment epithelium): a vertex in
   // contact stays put while the tangential load is below this fraction of the normal load.
@@ -245,14 +246,35 @@ class TissueWorld {
   struct LocalForce {
     LocalForceDescription d;
   };
+  // One spring as the sweep sees it during a step (built each step by pack_springs, in sweep
+  // order). Only springs with at least one movable end are packed.
+  struct SolverSpring {
+    std::uint32_t a, b;        // end vertices
+    std::uint32_t edge;        // for the multipliers of the accumulating (iterations > 1) sweep
+    std::uint32_t wake_block;  // 1 + the block of a sleeping end (the pull may wake it); 0: none
+    double wake_length;        // the spring's length when that block fell asleep
+    double wa, wb;             // effective inverse masses of the ends (constant within a step)
+    Vec3 rest_vec;
+    double rest_len;
+    double kh2;            // k h²
+    double kth;            // k τ h (the dashpot)
+    double inverse_denominator;  // 1 / ((wa + wb)(k h² + k τ h) + 1), the distance term's XPBD gain
+    double direction_gain; // the capped gain of the rest-direction term (single-iteration sweeps)
+  };
   struct Scratch {  // per surface, sized to capacity once
     std::vector<Vec3> previous, acceleration, rollback_x, rollback_v;
     std::vector<double> drag_rate;
+    std::vector<double> velocity_keep;  // 1 / (1 + h·drag_rate): the implicit drag's factor per substep
     // Inverse mass seen by the constraints during this step: 1 / (m + h·c). Treating drag
     // implicitly adds h·c to the mass in the substep's equations; using the same effective mass
     // in prediction and projection keeps static equilibria and force estimates unbiased by drag.
     std::vector<double> effective_inverse_mass;
     std::vector<double> current_area;  // each vertex's share of the current (stretched) area
+    // Twice each triangle's current area, computed once per step for the triangles of awake
+    // vertices (area_epoch tells which are this step's), shared by its three corners.
+    std::vector<double> triangle_area2;
+    std::vector<std::uint64_t> triangle_epoch;
+    std::uint64_t area_epoch = 0;
     // Normal load (acceleration) with which a vertex lies on the globe wall; 0 when not in contact.
     std::vector<double> contact_load;
     // Set when the wall moved the vertex in this substep: its velocity into the wall is then
@@ -264,12 +286,24 @@ class TissueWorld {
     std::vector<std::uint8_t> block_was_awake;  // awake during the previous step
     std::vector<std::uint8_t> wake_request;     // set during a step, applied at its end
     std::vector<double> block_max_speed2;
+    // What a sleeping block's springs to awake vertices looked like when it fell asleep: each
+    // block counts its sleeps, and a spring remembers its length for (block, count) — the first
+    // step it is packed with that block asleep (pack_springs). A sleeping block wakes when the
+    // length changes, not because it rests under tension (a detached retina always does).
+    std::vector<std::uint32_t> block_sleep_serial;
+    std::vector<std::uint64_t> wake_key;
+    std::vector<double> wake_length;
     // Springs grouped by the block of their lower vertex, with the other blocks each group
     // reaches, so a sweep can skip whole groups that touch only sleeping blocks. Rebuilt (without
     // allocating) whenever the surface's topology changes.
     std::vector<std::uint32_t> group_begin, group_edges, partner_begin, partners, mark;
     std::vector<std::uint8_t> group_active;
     std::uint64_t groups_version = ~std::uint64_t{0};
+    // The springs this step's sweeps project, in sweep order, with everything that is constant
+    // within a step gathered next to them (see pack_springs): the sweep reads one contiguous array
+    // instead of five edge arrays through an index, and skips no spring at run time.
+    std::vector<SolverSpring> springs;
+    std::uint32_t spring_count = 0;
     // Constraint multipliers accumulated over the iterations of one substep (only with
     // iterations > 1; a single iteration starts every constraint from zero).
     std::vector<double> lambda_distance;
@@ -284,7 +318,10 @@ class TissueWorld {
   // Stages of a step (one file each: stage_forces.cpp, stage_constraints.cpp, stage_step.cpp).
   void compute_external_accelerations(double h);
   void integrate_and_predict(double h);
-  void project_springs(std::uint32_t s, double h, bool accumulate);
+  void pack_springs(double h);
+  void project_springs(std::uint32_t s, bool accumulate);
+  template <bool kAccumulate, bool kDirection>
+  void sweep_springs(std::uint32_t s);
   void project_attachments(double h, bool accumulate);
   void project_wall();
   void project_grips(double h, double fraction);

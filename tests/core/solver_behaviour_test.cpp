@@ -287,8 +287,11 @@ TEST(SolverBehaviour, RestingTissueSleepsAndWakesWhenPulled) {
   const std::uint32_t blocks = (static_cast<std::uint32_t>(small_retina().retina_vertices) + 63) / 64;
   EXPECT_LE(sleeping.awake_before, blocks / 20) << "a retina at rest on the choroid should (almost all) sleep";
   EXPECT_GT(sleeping.awake_after, 0u) << "pulling the anchors must wake the tissue around them";
-  EXPECT_GT((reference.end - reference.start).norm(), 0.05) << "the pull moved the tissue next to the disc";
-  EXPECT_LT((sleeping.end - reference.end).norm(), 0.02) << "sleeping must not change the outcome";
+  // Intraocular pressure holds the attached retina on the wall (the wall takes the pressure only
+  // as far as the springs leave it to), so the lift stretches the tissue by the disc more than it
+  // lifts it: ~0.03 mm of motion, and sleeping must reproduce it to a third of that.
+  EXPECT_GT((reference.end - reference.start).norm(), 0.02) << "the pull moved the tissue next to the disc";
+  EXPECT_LT((sleeping.end - reference.end).norm(), 0.01) << "sleeping must not change the outcome";
 }
 
 TEST(SolverBehaviour, TinyTrianglesStayStable) {
