@@ -176,6 +176,9 @@ void CommandServer::on_command(const vitreo_lcm::operator_command_t& command) {
     copy_text(a.arg, cmd->arg);
     a.seq = cmd->seq;
     if (!queue_.try_push(a)) v = {false, "physics command queue is full"};
+    if (v.accepted && a.code == CommandCode::SaveSnapshot && !snapshot_folder_.empty()) {
+      v.reason = "-> " + snapshot_folder_ + "/" + cmd->arg + ".snapshot";
+    }
   }
   vitreo_lcm::command_ack_t ack;
   ack.utime_us = wall_time_us();

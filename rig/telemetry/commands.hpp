@@ -81,6 +81,10 @@ class CommandServer {
   runtime::TripleBuffer<CommandContext>& context() noexcept { return context_; }
   bool poll(AcceptedCommand& out) noexcept { return queue_.try_pop(out); }
 
+  // Where "save snapshot NAME" files go: an accepted SAVE_SNAPSHOT's ack says "→ FOLDER/NAME.snapshot"
+  // in its reason field. Before the telemetry thread starts.
+  void set_snapshot_folder(std::string folder) { snapshot_folder_ = std::move(folder); }
+
   std::uint64_t accepted() const noexcept { return accepted_; }
   std::uint64_t refused() const noexcept { return refused_; }
 
@@ -96,6 +100,7 @@ class CommandServer {
   runtime::TripleBuffer<CommandContext> context_;
   runtime::SpscRing<AcceptedCommand> queue_;
   std::map<std::string, std::int64_t> last_seq_;  // per source: replays and reordering are refused
+  std::string snapshot_folder_;
   std::uint64_t accepted_ = 0;
   std::uint64_t refused_ = 0;
 };

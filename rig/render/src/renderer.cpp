@@ -755,7 +755,13 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
       glActiveTexture(GL_TEXTURE1);
       glBindTexture(GL_TEXTURE_2D, d.gpu->burn_texture);
     }
+    // Wireframe (operator toggle): the deformable tissue's triangles as lines, to see the mesh.
+    const bool lines = scene.wireframe && d.mesh &&
+                       (d.mesh->material == MaterialKind::Retina || d.mesh->material == MaterialKind::Membrane ||
+                        d.mesh->material == MaterialKind::Gel);
+    if (lines) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     draw(d);
+    if (lines) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   };
 
   // Translucent layers back to front, from the midpoint between the eyes (the base is small

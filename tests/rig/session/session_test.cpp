@@ -8,11 +8,13 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <cstdio>
+#include <fstream>
 #include <filesystem>
 #include <cmath>
 #include <map>
 #include <string>
 
+#include "rig/scene_io/case_loader.hpp"
 #include "rig/session/rig_session.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
@@ -32,14 +34,21 @@ std::string temp_path(const std::string& name) {
   return (std::filesystem::path(::testing::TempDir()) / ("vitreo-" + std::to_string(::getpid()) + "-" + name)).string();
 }
 
+const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
+
+// A real case (scenes/), lightened: a coarse retina and small textures keep the tests quick.
+rig::ModelConfig small_model(const std::vector<std::string>& files = {kScenes + "/exercise_pull_tissue.toml"}) {
+  rig::ModelConfig m;
+  for (const auto& f : files) m.cases.push_back(scene_io::read_case_text(f));
+  m.load.retina_vertices = 1500;
+  m.load.texture_size_px = 128;
+  m.load.cache_dir = (std::filesystem::path(::testing::TempDir()) / "vitreo-session-cache").string();
+  return m;
+}
+
 rig::SessionConfig small_session(const std::string& tag, std::uint64_t steps) {
   rig::SessionConfig c;
-  c.model.scene.retina_vertices = 2000;
-  c.model.scene.membrane = true;
-  rig::Port port;
-  port.outward = core::Vec3(-0.81, 0.29, 0.5).normalized();
-  port.position_mm = 11.5 * port.outward;
-  c.model.ports = {port};
+  c.model = small_model();
   c.steps = steps;
   c.lcm_url = "file://" + temp_path(tag + "-telemetry.lcmlog") + "?mode=w";
   c.record_path = temp_path(tag + "-session.lcmlog");
@@ -125,9 +134,76 @@ TEST(RigSession, RendersStereoFramesOfTheRunAndTheLastOne) {
   std::filesystem::remove_all(config.png_dir);
 }
 
+TEST(RigSession, ReplayRebuildsTheCaseFromTheRecordingNotFromTheFolder) {
+  // The case lives in a scratch folder that is edited after the session: the replay must not care.
+  const auto dir = std::filesystem::path(temp_path("case-dir"));
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kScenes + "/exercise_pull_tissue.toml", dir / "case.toml",
+                             std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(kScenes + "/materials.toml", dir / "materials.toml",
+                             std::filesystem::copy_options::overwrite_existing);
+  auto config = small_session("from-recording", 800);
+  config.model = small_model({(dir / "case.toml").string()});
+  const rig::SessionSummary live = rig::run_session(config);
+  EXPECT_EQ(live.case_name, "exercise_pull_tissue");
+  EXPECT_EQ(live.case_file, (dir / "case.toml").string());
+  // Change the case on disk (a stronger patch) and break its library.
+  {
+    std::ofstream f(dir / "case.toml", std::ios::app);
+    f << "\n# edited after the session\n";
+  }
+  std::filesystem::remove(dir / "materials.toml");
+  const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.case_id, "exercise_pull_tissue");
+  EXPECT_EQ(replay.state_hash, live.state_hash) << "replay rebuilt the case from the recording's text";
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(config.record_path);
+}
+
+TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts) {
+  const rig::ModelConfig mc = small_model({kScenes + "/low_membrane_macula.toml"});
+  rig::SimulationModel model(mc);
+  const core::Scene& scene = model.scene();
+  EXPECT_EQ(scene.description.name, "low_membrane_macula");
+  // The case lists forceps, pick, scissors, vitrector, light_pipe, infusion: the four hand-held
+  // tools on tracker 0 in that order, the light pipe on its own, the infusion is no instrument.
+  const auto& c = model.current_case();
+  ASSERT_EQ(c.tools.size(), 4u);
+  EXPECT_EQ(c.tools[0], core::InstrumentKind::kForceps);
+  EXPECT_EQ(c.tools[3], core::InstrumentKind::kVitrector);
+  EXPECT_EQ(c.light_pipe, 4);
+  EXPECT_EQ(model.instrument_system().instrument_count(), 5u);
+  // The tool pivots in the eye model's working_1 sclerotomy: between its outer and inner openings.
+  const core::SclerotomyPort* w1 = nullptr;
+  for (const auto& p : scene.eye.ports) {
+    if (p.name == "working_1") w1 = &p;
+  }
+  ASSERT_NE(w1, nullptr);
+  EXPECT_LT((c.tracker_ports[rig::kToolTracker].position_mm - 0.5 * (w1->outer_mm + w1->inner_mm)).norm(), 1e-9);
+  // The resolution override reached the build, and the start is the settled state.
+  EXPECT_NEAR(static_cast<double>(scene.world.surface(scene.retina).vertex_count()), 1500.0, 300.0);
+  EXPECT_TRUE(scene.settle.settled);
+  // A tracked forceps tip inside the eye puts the forceps (not another tool) in through working_1.
+  telemetry::DeviceInput in;
+  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
+  in.n_values = 11;
+  const core::Vec3 tip = c.tracker_ports[0].position_mm + 4.0 * (c.focus_mm - c.tracker_ports[0].position_mm).normalized();
+  in.values[0] = tip.x(); in.values[1] = tip.y(); in.values[2] = tip.z();
+  in.values[3] = 1.0;   // q w
+  in.values[8] = 1.0;   // quality
+  in.values[9] = 0.0;   // instrument id: the tool tracker
+  in.values[10] = 3.0;  // tool type
+  ASSERT_TRUE(model.apply(in));
+  model.step();
+  EXPECT_TRUE(model.instrument_system().instrument(0).input.present);
+  EXPECT_TRUE(model.instrument_system().instrument(0).inside);
+  EXPECT_FALSE(model.instrument_system().instrument(1).input.present);
+  // Where the tracker put it (the eye turns only slightly under the port's push).
+  EXPECT_LT((model.instrument_system().instrument(0).frame.tip - tip).norm(), 0.5);
+}
+
 TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
-  rig::ModelConfig mc;
-  mc.scene.retina_vertices = 500;
+  const rig::ModelConfig mc = small_model();
   rig::SimulationModel model(mc);
   rig::SimulationModel fresh(mc);
   auto command = [](int code, double value) {
@@ -145,8 +221,13 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
   for (int i = 0; i < 20; ++i) model.step();
   EXPECT_EQ(model.world().state_hash(), moved) << "paused physics does not advance";
   ASSERT_TRUE(model.apply(command(4, 0)));  // resume
-  ASSERT_TRUE(model.apply(command(5, 0)));  // reset
+  telemetry::DeviceInput reload;            // a reset reaches the model as the case reloaded
+  reload.device_kind = rig::kCaseKind;
+  reload.n_values = 1;
+  reload.values[0] = 0;
+  ASSERT_TRUE(model.apply(reload));
   EXPECT_EQ(model.world().state_hash(), fresh.world().state_hash()) << "reset returns the case to its start";
+  EXPECT_EQ(model.case_loads(), 1u);
   ASSERT_TRUE(model.apply(command(9, 2.5)));
   EXPECT_EQ(model.zoom_override(), 2.5);
   telemetry::DeviceInput bad = command(9, std::nan(""));
