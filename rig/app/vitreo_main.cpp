@@ -135,6 +135,7 @@ int main(int argc, char** argv) {
   bool realtime = false;
   bool verify_replay = true;
   bool render = true;
+  bool commands_from_stdin = false;
   int eye_width = 640;
 
   CLI::App app{"vitreo: vitreoretinal surgery training rig — the real-time simulation process.\n"
@@ -166,6 +167,9 @@ int main(int argc, char** argv) {
   app.add_flag("--realtime", realtime, "ask for SCHED_FIFO, locked memory and a dedicated core for physics");
   app.add_flag("!--no-verify", verify_replay, "do not replay the recording at the end");
   app.add_flag("!--no-render", render, "no stereo frames (EGL) at all");
+  app.add_flag("--commands-from-stdin", commands_from_stdin,
+               "read operator commands from stdin even when it is not a terminal (a pipe, a script); when it is a\n"
+               "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X");
   app.add_option("--eye-size", eye_width, "width of each eye's image in pixels (height = 4/5 of it)")
       ->check(CLI::Range(64, 4096));
   try {
@@ -219,6 +223,11 @@ int main(int argc, char** argv) {
     config.snapshot_dir = out.string();
     config.realtime = realtime;
     config.render = render;
+    if (commands_from_stdin || ::isatty(STDIN_FILENO)) {
+      config.command_fd = STDIN_FILENO;
+      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X — one per line\n");
+      std::fflush(stdout);
+    }
     config.eye_width = eye_width;
     config.eye_height = eye_width * 4 / 5;
     config.png_dir = (out / "frames").string();

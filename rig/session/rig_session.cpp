@@ -18,6 +18,7 @@
 #include "rig/telemetry/commands.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "rig/telemetry/terminal_commands.hpp"
 #include "rig/session/case_switcher.hpp"
 #include "rig/session/frame_source.hpp"
 #include "rig/session/snapshot_writer.hpp"
@@ -263,6 +264,7 @@ SessionSummary run_session(const SessionConfig& config) {
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();
     publisher.handle_incoming();
+    commands.pump_local();  // commands typed on the terminal: the same validation and queue
   });
   if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
   harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(); });
@@ -279,9 +281,14 @@ SessionSummary run_session(const SessionConfig& config) {
     harness.add_service("render", std::chrono::milliseconds(static_cast<int>(1000.0 / config.display_hz)), render_latest);
   }
 
+  std::unique_ptr<telemetry::TerminalCommands> terminal;
+  if (config.command_fd >= 0) terminal = std::make_unique<telemetry::TerminalCommands>(config.command_fd, commands, config.command_echo);
+
   hub.start();
   harness.start();
+  if (terminal) terminal->start();
   harness.wait_physics();
+  if (terminal) terminal->stop();
   harness.stop();
   hub.stop();
   if (recorder) recorder->close();

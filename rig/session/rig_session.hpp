@@ -2,6 +2,7 @@
 // A whole session: devices → physics (fixed step) → telemetry and recording, on separate threads
 // (rig/runtime/README.md has the diagram). Physics only ever touches wait-free mailboxes.
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <optional>
 #include <string>
@@ -22,6 +23,10 @@ struct SessionConfig {
   // Operator "save snapshot NAME" writes NAME.snapshot here (core/scene/snapshot format); empty:
   // the folder of record_path, else the current folder.
   std::string snapshot_dir;
+  // Operator commands typed on a terminal: lines read from this descriptor on their own thread
+  // (telemetry::TerminalCommands), acks printed to command_echo. -1: none.
+  int command_fd = -1;
+  std::FILE* command_echo = stdout;
   bool realtime = false;    // SCHED_FIFO/mlockall/affinity for physics where permitted
   // Scripted actions at given steps, run on the physics thread (hardware-in-the-loop tests pull a
   // simulated cable with it). Must be quick and wait-free, like everything on that thread.
