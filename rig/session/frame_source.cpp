@@ -322,11 +322,15 @@ render::FrameScene FrameBuilder::build(const ViewSnapshot& snap) {
   if (snap.fluid_level_z_mm < 1e299) scene.fluid_gas = render::FluidGas{{0, 0, 1}, static_cast<float>(snap.fluid_level_z_mm)};
   // The surgeon's wide-angle viewing system: it brings the fundus into view through the pupil with
   // its own optics; we do not model that refraction but place the virtual camera on the optical
-  // axis just behind the lens, looking down at the case's region of interest. Zoom narrows it.
-  scene.microscope.target_mm = to_render(cv->focus_mm);
+  // axis just behind the lens, looking down the axis. Zoom narrows the field.
+  // The field opens up (as wide-angle systems do, to ~130°) until the region of interest is in it.
+  const core::Vec3 camera(0.0, 0.0, cv->camera_z_mm);
+  const core::Vec3 to_focus = cv->focus_mm - camera;
+  const double off_axis_deg = std::atan2(std::hypot(to_focus.x(), to_focus.y()), -to_focus.z()) * 180.0 / std::numbers::pi;
+  scene.microscope.target_mm = {0.0f, 0.0f, static_cast<float>(cv->eye.fovea_mm.z())};
   scene.microscope.wide_angle = true;
   scene.microscope.wide_distance_mm = cv->camera_z_mm;
-  scene.microscope.wide_field_deg = 90.0f;
+  scene.microscope.wide_field_deg = static_cast<float>(std::clamp(2.0 * (off_axis_deg + 14.0), 90.0, 130.0));
   scene.microscope.zoom = static_cast<float>(snap.zoom);
   scene.wireframe = snap.wireframe;
   return scene;
