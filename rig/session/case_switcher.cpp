@@ -50,9 +50,10 @@ bool CaseSwitcher::retire(std::unique_ptr<PreparedCase>& c) noexcept {
   return true;
 }
 
-void CaseSwitcher::service() noexcept {
+void CaseSwitcher::service(bool load_cases) noexcept {
   PreparedCase* old = nullptr;
   while (retired_.try_pop(old)) delete old;
+  if (!load_cases) return;
   if (ready_.load(std::memory_order_acquire) != nullptr) return;  // physics has not taken the last one yet
   const int wanted = request_.load(std::memory_order_acquire);
   if (wanted < 0) return;

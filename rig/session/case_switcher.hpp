@@ -44,7 +44,8 @@ class CaseSwitcher {
   // ---- loader service thread ----
   // Frees retired cases and loads a requested one. Never throws (a failed load is logged and
   // counted; the session stays on its case).
-  void service() noexcept;
+  // `load`: false once the session is ending (only frees).
+  void service(bool load = true) noexcept;
   std::uint64_t failures() const noexcept { return failures_.load(std::memory_order_relaxed); }
   std::string last_error() const;
 

@@ -267,7 +267,7 @@ SessionSummary run_session(const SessionConfig& config) {
     commands.pump_local();  // commands typed on the terminal: the same validation and queue
   });
   if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
-  harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(); });
+  harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(!harness.physics_done()); });
   harness.add_service("snapshots", std::chrono::milliseconds(20), [&] { snapshots.service(); });
   std::uint64_t last_view = ~std::uint64_t{0};
   auto render_latest = [&] {

@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -317,4 +318,72 @@ TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
   const double r0 = std::hypot(c0.x - mid.x, c0.y - mid.y), r1 = std::hypot(c1.x - mid.x, c1.y - mid.y);
   EXPECT_NEAR(r1 / r0, 2.0, 0.15) << "zoom 2 doubles image distances from the centre";
   EXPECT_GT(vr::compare_images(render(zoomed), render(base)).fraction_over, 0.05);
+}
+
+// A laser burn where the aiming beam hit: the endolaser (the laser exercise's tool) fires once
+// through the pedal's laser switch; the burn the instrument system records reaches the frame at
+// that spot and shows whitish there, against the same frame without it.
+TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
+  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_laser_tear.toml")};
+  scene_io::CaseLoadOptions load;
+  load.retina_vertices = 2000;
+  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  rig::CaseSwitcher loader(cases, load, true);
+  rig::ModelConfig mc;
+  mc.cases = cases;
+  mc.load = load;
+  rig::SimulationModel model(mc, loader.load_now(0));
+  const rig::PreparedCase& c = model.current_case();
+  ASSERT_FALSE(c.tools.empty());
+  ASSERT_EQ(c.tools[0], core::InstrumentKind::kEndolaser);
+  // Aim at attached retina beside the fovea (a 0.2 mm burn needs the microscope zoomed in to span
+  // a few pixels of this small frame), with the light pipe on the same spot.
+  const core::Vec3 aim = model.scene().eye.wall_point(8.0 * std::numbers::pi / 180.0, std::numbers::pi);
+  const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
+  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
+  ASSERT_TRUE(model.apply(tracker(rig::kLightPipeTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 8.0 * (aim - tp).normalized(), 0.0)));
+  telemetry::DeviceInput zoom;
+  zoom.device_kind = rig::kCommandKind;
+  zoom.n_values = 2;
+  zoom.values[0] = 9;
+  zoom.values[1] = 10.0;
+  ASSERT_TRUE(model.apply(zoom));
+  model.step();
+  auto pedal = [](int switches) {
+    telemetry::DeviceInput in;
+    in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
+    in.n_values = 7;
+    in.values[0] = 0;  // the vitrectomy pedal
+    in.values[1] = 2;
+    in.values[6] = switches;
+    return in;
+  };
+  rig::FrameBuilder builder;
+  rig::ViewSnapshot before_view;
+  ASSERT_TRUE(rig::capture_view(model, 1, 0.001, before_view));
+  const vr::FrameScene before = builder.build(before_view);
+  ASSERT_TRUE(model.apply(pedal(1 << 1)));  // laser switch (default mapping: switch 1)
+  model.step();
+  ASSERT_TRUE(model.apply(pedal(0)));
+  model.step();
+  ASSERT_EQ(model.instrument_system().burns().size(), 1u) << "one pulse on the rising edge";
+  const core::Vec3 hit = model.instrument_system().burn_position(model.instrument_system().burns()[0]);
+  rig::ViewSnapshot view;
+  ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
+  ASSERT_EQ(view.n_burns, 1u);
+  const vr::FrameScene after = builder.build(view);
+  std::size_t burns = 0;
+  for (const auto& m : after.meshes) burns += m.burns.size();
+  EXPECT_EQ(burns, 1u);
+  vr::FrameScene cleared = after;
+  for (auto& m : cleared.meshes) m.burns.clear();
+  const vr::Vec2 px = render::testing::project_to_pixel(after, 0, vr::Vec3{float(hit.x()), float(hit.y()), float(hit.z())}, kW, kH);
+  ASSERT_TRUE(px.x >= 0 && px.x < kW && px.y >= 0 && px.y < kH);
+  EXPECT_LT((hit - aim).norm(), 1.0) << "the beam went where the laser was aimed";
+  const Rgb with = patch(render_stereo(after).eye(0), px, 1), without = patch(render_stereo(cleared).eye(0), px, 1);
+  std::printf("burn at pixel (%.1f, %.1f): luma %.1f spread %.1f vs %.1f / %.1f without\n", px.x, px.y, with.luma(), with.spread(),
+              without.luma(), without.spread());
+  EXPECT_GT(with.luma(), without.luma() + 15.0) << "the burn is lighter";
+  EXPECT_LT(with.spread() / with.luma(), without.spread() / without.luma()) << "and whiter";
 }

@@ -10,7 +10,9 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <fstream>
 #include <thread>
 #include <filesystem>
@@ -20,7 +22,10 @@
 
 #include "core/scene/snapshot.hpp"
 #include "rig/scene_io/case_loader.hpp"
+#include "rig/session/case_switcher.hpp"
+#include "rig/session/frame_source.hpp"
 #include "rig/session/rig_session.hpp"
+#include "rig/session/snapshot_writer.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
@@ -312,4 +317,58 @@ TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReprod
   EXPECT_EQ(replay.state_hash, live.state_hash) << "the recorded case switches replay at the same steps";
   std::filesystem::remove_all(config.snapshot_dir);
   std::filesystem::remove(config.record_path);
+}
+
+// ---- The physics thread's side of a case switch, a snapshot and a view capture never allocates ----
+namespace {
+thread_local bool g_counting = false;
+thread_local std::size_t g_allocations = 0;
+}  // namespace
+// Not inlined: GCC would otherwise pair the inlined free() with operator new and warn.
+[[gnu::noinline]] void* operator new(std::size_t n) {
+  if (g_counting) ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+TEST(PhysicsSide, InstallingAPreparedCaseCapturingTheViewAndASnapshotDoNotAllocate) {
+  rig::ModelConfig mc = small_model({kScenes + "/exercise_pull_tissue.toml", kScenes + "/exercise_cut_path.toml"});
+  rig::CaseSwitcher loader(mc.cases, mc.load, /*visuals=*/true);
+  rig::SimulationModel model(mc, loader.load_now(0));
+  rig::SnapshotWriter snapshots(temp_path("alloc-snapshots"), 2 * core::encode_snapshot(model.world(), "x").size() + (1u << 20));
+  runtime::TripleBuffer<rig::ViewSnapshot> views;
+  model.step();
+  std::unique_ptr<rig::PreparedCase> next = loader.load_now(1);  // the loader thread's work
+  telemetry::DeviceInput switch_input;
+  switch_input.device_kind = rig::kCaseKind;
+  switch_input.n_values = 1;
+  switch_input.values[0] = 1;
+
+  // What physics does at a step boundary: capture (three slots, each sized for the case on first use).
+  g_allocations = 0;
+  g_counting = true;
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(rig::capture_view(model, static_cast<std::uint64_t>(i), 0.0, views.write_slot()));
+    views.publish();
+  }
+  model.stage(std::move(next));
+  ASSERT_TRUE(model.apply(switch_input));
+  std::unique_ptr<rig::PreparedCase> retired = model.take_retired();
+  const bool handed_back = loader.retire(retired);
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(rig::capture_view(model, static_cast<std::uint64_t>(10 + i), 0.0, views.write_slot()));
+    views.publish();
+  }
+  const bool captured = snapshots.capture(model.world(), model.scene().description.name, "alloc-test", 14);
+  g_counting = false;
+  EXPECT_EQ(g_allocations, 0u) << "physics allocated while switching case, capturing views or a snapshot";
+  EXPECT_TRUE(handed_back);
+  EXPECT_TRUE(captured);
+  EXPECT_EQ(model.scene().description.name, "exercise_cut_path");
+  loader.service();  // the loader frees the retired case
+  snapshots.service();
+  EXPECT_TRUE(std::filesystem::exists(temp_path("alloc-snapshots") + "/alloc-test.snapshot"));
+  std::filesystem::remove_all(temp_path("alloc-snapshots"));
 }
