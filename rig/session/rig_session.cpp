@@ -208,7 +208,8 @@ SessionSummary run_session(const SessionConfig& config) {
       switch (cmd.code) {
         case telemetry::CommandCode::NextCase: switcher.request(std::min(target + 1, model.case_count() - 1)); break;
         case telemetry::CommandCode::PreviousCase: switcher.request(std::max(target - 1, 0)); break;
-        case telemetry::CommandCode::Reset: switcher.request(model.case_index()); break;
+        // Reset: the case the operator is in — or on the way to, when a switch is still loading.
+        case telemetry::CommandCode::Reset: switcher.request(target); break;
         case telemetry::CommandCode::SaveSnapshot:
           (void)snapshots.capture(model.world(), model.scene().description.name, cmd.arg, k);
           break;

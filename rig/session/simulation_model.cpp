@@ -209,6 +209,7 @@ core::StepReport SimulationModel::step() {
     in.light_power_mw = 5.0 + 10.0 * c.light_level;
     (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
+  sys.set_air_infusion(c.air_infusion);
   sys.set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
   return sys.step(config_.dt_s).tissue;
@@ -238,6 +239,7 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.zoom);
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
+  h.add_u64(c.air_infusion ? 1u : 0u);
   h.add_double(eye_rotation_.w());
   h.add_double(eye_rotation_.x());
   h.add_double(eye_rotation_.y());

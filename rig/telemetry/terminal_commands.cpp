@@ -76,8 +76,8 @@ void TerminalCommands::handle_line(const std::string& line) {
     std::fflush(out_);
     return;
   }
-  // The telemetry thread answers within a few milliseconds; give it a second.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  // The telemetry thread answers within a few milliseconds; give it two seconds (a loaded machine).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
   LocalAck ack;
   bool got = false;
   while (running_.load() && std::chrono::steady_clock::now() < deadline) {

@@ -387,3 +387,54 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   EXPECT_GT(with.luma(), without.luma() + 15.0) << "the burn is lighter";
   EXPECT_LT(with.spread() / with.luma(), without.spread() / without.luma()) << "and whiter";
 }
+
+// Fluid–air exchange: the pedal's air switch turns the infusion to air, the flute needle aspirates
+// (vacuum pedal) and the level falls toward its tip; the frame carries that level to the renderer
+// (whose own test, RenderScenes.FluidGasInterfaceIsVisible, shows the interface at the wall; from
+// this view, behind the lens, the meniscus lies outside the field).
+TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
+  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_drain_tear.toml")};
+  scene_io::CaseLoadOptions load;
+  load.retina_vertices = 2000;
+  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  rig::CaseSwitcher loader(cases, load, true);
+  rig::ModelConfig mc;
+  mc.cases = cases;
+  mc.load = load;
+  rig::SimulationModel model(mc, loader.load_now(0));
+  const rig::PreparedCase& c = model.current_case();
+  ASSERT_EQ(c.tools.at(0), core::InstrumentKind::kDrainageNeedle);
+  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
+  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 12.0 * (c.focus_mm - tp).normalized(), 0.0)));
+  auto pedal = [](double vacuum, int switches) {
+    telemetry::DeviceInput in;
+    in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
+    in.n_values = 7;
+    in.values[0] = 0;
+    in.values[1] = 2;
+    in.values[2] = vacuum;
+    in.values[6] = switches;
+    return in;
+  };
+  rig::FrameBuilder builder;
+  model.step();
+  rig::ViewSnapshot v0;
+  ASSERT_TRUE(rig::capture_view(model, 1, 0.001, v0));
+  const vr::FrameScene fluid = builder.build(v0);
+  EXPECT_FALSE(fluid.fluid_gas.has_value()) << "all fluid before the exchange";
+  ASSERT_TRUE(model.apply(pedal(0.0, 1 << 3)));  // air on
+  ASSERT_TRUE(model.apply(pedal(1.0, 0)));       // full aspiration
+  ASSERT_TRUE(model.controls().air_infusion);
+  model.step();
+  const double top = model.instrument_system().fluid_level_z_mm();
+  for (int i = 0; i < 400; ++i) model.step();
+  const double level = model.instrument_system().fluid_level_z_mm();
+  std::printf("fluid level: %.2f mm at the start of the exchange, %.2f mm after 0.4 s of aspiration\n", top, level);
+  EXPECT_NEAR(top - level, 0.4 * 2.0, 0.1) << "falls at the aspiration rate (2 mm/s at full vacuum)";
+  rig::ViewSnapshot v1;
+  ASSERT_TRUE(rig::capture_view(model, 402, 0.402, v1));
+  const vr::FrameScene gas = builder.build(v1);
+  ASSERT_TRUE(gas.fluid_gas.has_value());
+  EXPECT_NEAR(gas.fluid_gas->level_mm, level, 1e-3);
+  EXPECT_NEAR(gas.fluid_gas->up.z, 1.0f, 1e-6f) << "gas rises anteriorly (patient supine)";
+}

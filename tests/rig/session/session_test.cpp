@@ -250,7 +250,7 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
 // boundaries; the case switches are recorded, so the replay — which loads the cases from the
 // recording in place — ends in the same state.
 TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReproducesThem) {
-  auto config = small_session("commands", 5000);
+  auto config = small_session("commands", 6000);
   config.model = small_model({kScenes + "/exercise_pull_tissue.toml", kScenes + "/exercise_cut_path.toml"});
   config.snapshot_dir = temp_path("snapshots");
   int master = -1, slave = -1;
@@ -287,12 +287,15 @@ TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReprod
   EXPECT_NE(acks.find("look-1.snapshot"), std::string::npos) << "the ack says where the snapshot goes:\n" << acks;
   EXPECT_NE(acks.find("> reset: accepted"), std::string::npos) << acks;
 
-  // Three loads: next, previous, reset — in that order.
-  ASSERT_EQ(live.cases_loaded.size(), 3u) << ::testing::PrintToString(live.cases_loaded);
+  // Loads: next, previous, reset — in that order (a reset arriving while "previous" is still
+  // waiting for the loader merges with it: the same case, loaded once).
+  ASSERT_GE(live.cases_loaded.size(), 2u) << ::testing::PrintToString(live.cases_loaded);
+  ASSERT_LE(live.cases_loaded.size(), 3u) << ::testing::PrintToString(live.cases_loaded);
   EXPECT_NE(live.cases_loaded[0].find("exercise_cut_path"), std::string::npos);
-  EXPECT_NE(live.cases_loaded[1].find("exercise_pull_tissue"), std::string::npos);
-  EXPECT_NE(live.cases_loaded[2].find("exercise_pull_tissue"), std::string::npos);
-  EXPECT_EQ(live.steps, 5000u) << "physics kept its steps while cases loaded";
+  for (std::size_t i = 1; i < live.cases_loaded.size(); ++i) {
+    EXPECT_NE(live.cases_loaded[i].find("exercise_pull_tissue"), std::string::npos) << live.cases_loaded[i];
+  }
+  EXPECT_EQ(live.steps, 6000u) << "physics kept its steps while cases loaded";
 
   // The snapshot is an exact state of the second case: it loads into that case built afresh and
   // verifies its recorded state hash (core::load_snapshot checks it).
