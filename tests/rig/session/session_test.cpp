@@ -170,6 +170,30 @@ TEST(RigSession, ReplayRebuildsTheCaseFromTheRecordingNotFromTheFolder) {
   std::filesystem::remove(config.record_path);
 }
 
+// The case list a recording carries: every byte of the case and library texts comes back; a cut or
+// foreign text is refused with a reason instead of building something else.
+TEST(CaseList, RoundTripsTheTextsAndRefusesATruncatedOne) {
+  rig::ModelConfig m = small_model({kScenes + "/low_membrane_macula.toml", kScenes + "/exercise_cut_path.toml"});
+  m.first_case = 1;
+  const std::string text = rig::encode_case_list(m);
+  rig::ModelConfig back;
+  rig::decode_case_list(text, back);
+  ASSERT_EQ(back.cases.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back.cases[i].file_name, m.cases[i].file_name);
+    EXPECT_EQ(back.cases[i].text, m.cases[i].text);
+    EXPECT_EQ(back.cases[i].library_text, m.cases[i].library_text);
+  }
+  EXPECT_FALSE(back.cases[1].library_text.empty()) << "the materials library travels with the case";
+  EXPECT_EQ(back.first_case, 1);
+  EXPECT_EQ(back.load.retina_vertices, 1500);
+  EXPECT_EQ(back.load.texture_size_px, 128);
+  rig::ModelConfig untouched;
+  EXPECT_THROW(rig::decode_case_list(text.substr(0, text.size() - 10), untouched), std::runtime_error);
+  EXPECT_THROW(rig::decode_case_list("retina-cap vertices=5000", untouched), std::runtime_error);
+  EXPECT_TRUE(untouched.cases.empty()) << "a refused list leaves the configuration alone";
+}
+
 TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts) {
   const rig::ModelConfig mc = small_model({kScenes + "/low_membrane_macula.toml"});
   rig::SimulationModel model(mc);
