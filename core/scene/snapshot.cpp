@@ -44,21 +44,28 @@ T get(const std::uint8_t* p) {
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_snapshot(const TissueWorld& world, const std::string& scene_name) {
-  std::vector<std::uint8_t> payload;
-  put(payload, static_cast<std::uint64_t>(scene_name.size()));
-  put_bytes(payload, scene_name.data(), scene_name.size());
-  put(payload, world.state_hash());
-  WorldAccess::write_state(world, payload);
-
-  std::vector<std::uint8_t> out;
-  out.reserve(kHeaderBytes + payload.size());
+void encode_snapshot(const TissueWorld& world, const std::string& scene_name, std::vector<std::uint8_t>& out) {
+  // Header first with size and checksum patched in afterwards, so the payload is written once,
+  // straight into `out` (no allocation when its capacity suffices).
+  out.clear();
   put_bytes(out, kMagic, sizeof kMagic);
   put(out, kSnapshotVersion);
   put(out, std::uint32_t{0});
-  put(out, static_cast<std::uint64_t>(payload.size()));
-  put(out, fnv1a(payload.data(), payload.size()));
-  put_bytes(out, payload.data(), payload.size());
+  put(out, std::uint64_t{0});
+  put(out, std::uint64_t{0});
+  put(out, static_cast<std::uint64_t>(scene_name.size()));
+  put_bytes(out, scene_name.data(), scene_name.size());
+  put(out, world.state_hash());
+  WorldAccess::write_state(world, out);
+  const std::uint64_t size = out.size() - kHeaderBytes;
+  const std::uint64_t checksum = fnv1a(out.data() + kHeaderBytes, static_cast<std::size_t>(size));
+  std::memcpy(out.data() + 16, &size, sizeof size);
+  std::memcpy(out.data() + 24, &checksum, sizeof checksum);
+}
+
+std::vector<std::uint8_t> encode_snapshot(const TissueWorld& world, const std::string& scene_name) {
+  std::vector<std::uint8_t> out;
+  encode_snapshot(world, scene_name, out);
   return out;
 }
 
@@ -91,7 +98,10 @@ Status decode_snapshot(TissueWorld& world, std::span<const std::uint8_t> bytes, 
 }
 
 Status save_snapshot(const TissueWorld& world, const std::string& scene_name, const std::string& path) {
-  const std::vector<std::uint8_t> bytes = encode_snapshot(world, scene_name);
+  return write_snapshot_file(encode_snapshot(world, scene_name), path);
+}
+
+Status write_snapshot_file(std::span<const std::uint8_t> bytes, const std::string& path) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);

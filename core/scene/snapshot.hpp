@@ -28,11 +28,16 @@ struct SnapshotInfo {
 };
 
 std::vector<std::uint8_t> encode_snapshot(const TissueWorld& world, const std::string& scene_name);
+// The same into `out`, reusing its capacity: a real-time thread that reserved enough copies the
+// state without allocating and hands the bytes to another thread to write.
+void encode_snapshot(const TissueWorld& world, const std::string& scene_name, std::vector<std::uint8_t>& out);
 // Validates magic, version, size and checksum, then that the state fits the world; on any error the
 // world is unchanged. Afterwards world.state_hash() equals the hash recorded at save time.
 Status decode_snapshot(TissueWorld& world, std::span<const std::uint8_t> bytes, SnapshotInfo* info = nullptr);
 
 Status save_snapshot(const TissueWorld& world, const std::string& scene_name, const std::string& path);
 Status load_snapshot(TissueWorld& world, const std::string& path, SnapshotInfo* info = nullptr);
+// Writes encoded bytes atomically (temporary name, then rename).
+Status write_snapshot_file(std::span<const std::uint8_t> bytes, const std::string& path);
 
 }  // namespace vitreo::core

@@ -26,6 +26,7 @@ bool PedalMapper::apply(const PedalReading& r) {
     c_.reflux = bit(r.switches, m_.reflux_switch);
     c_.laser_fire = bit(r.switches, m_.laser_switch);
     if (bit(r.switches, m_.instrument_switch) && !bit(last_switches_[0], m_.instrument_switch)) ++c_.instrument_changes;
+    if (bit(r.switches, m_.air_switch) && !bit(last_switches_[0], m_.air_switch)) c_.air_infusion = !c_.air_infusion;
     last_switches_[0] = r.switches;
   } else if (r.pedal_id == m_.microscope_pedal_id) {
     c_.zoom = m_.zoom_min + axis(m_.zoom_axis) * (m_.zoom_max - m_.zoom_min);
@@ -66,6 +67,7 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
       {"reflux_switch", {nullptr, &m.reflux_switch, -1, 15}},
       {"laser_switch", {nullptr, &m.laser_switch, -1, 15}},
       {"instrument_switch", {nullptr, &m.instrument_switch, -1, 15}},
+      {"air_switch", {nullptr, &m.air_switch, -1, 15}},
       {"microscope_pedal_id", {nullptr, &m.microscope_pedal_id, 0, 255}},
       {"zoom_axis", {nullptr, &m.zoom_axis, -1, 3}},
       {"focus_axis", {nullptr, &m.focus_axis, -1, 3}},

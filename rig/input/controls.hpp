@@ -20,6 +20,7 @@ struct PedalMapping {
   int reflux_switch = 0;
   int laser_switch = 1;
   int instrument_switch = 2;
+  int air_switch = 3;  // fluid–air exchange: each press switches the infusion between fluid and air
 
   int microscope_pedal_id = 1;
   int zoom_axis = 0;
@@ -38,6 +39,7 @@ struct SurgicalControls {
   bool reflux = false;
   bool laser_fire = false;
   std::uint32_t instrument_changes = 0;  // rising edges of the instrument switch so far
+  bool air_infusion = false;             // the infusion runs air (fluid–air exchange), toggled by air_switch
   double zoom = 1.0;
   double focus_offset_mm = 0.0;
   double light_level = 0.7;  // 0..1 of the light source

@@ -32,27 +32,51 @@ std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 0xcbf29ce484222325UL
 
 }  // namespace
 
-std::string case_cache_key(const std::string& path) {
-  const core::SceneDescription d = load_scene_file(path);
-  std::uint64_t h = fnv1a(slurp(path));
-  const auto lib = std::filesystem::path(path).parent_path() / "materials.toml";
+CaseText read_case_text(const std::string& path) {
   std::error_code ec;
-  if (std::filesystem::is_regular_file(lib, ec)) h = fnv1a(slurp(lib.string()), h);
+  if (!std::filesystem::is_regular_file(path, ec)) throw SceneError(path, 0, "", "no such scene file");
+  CaseText c;
+  c.file_name = path;
+  c.text = slurp(path);
+  // Parsing reads the library the case names (relative to it) and tells us its text.
+  (void)parse_scene(c.text, path, nullptr, &c.library_text);
+  return c;
+}
+
+core::SceneDescription case_description(const CaseText& text, const CaseLoadOptions& options) {
+  core::SceneDescription d =
+      parse_scene(text.text, text.file_name, text.library_text.empty() ? nullptr : &text.library_text);
+  if (options.retina_vertices > 0) d.anatomy.retina_vertices = options.retina_vertices;
+  if (options.texture_size_px > 0) d.texture_size_px = options.texture_size_px;
+  d.validate();
+  return d;
+}
+
+std::string case_cache_key(const CaseText& text, const CaseLoadOptions& options) {
+  const core::SceneDescription d = case_description(text, options);
+  std::uint64_t h = fnv1a(text.text);
+  h = fnv1a(text.library_text, h);
   h = fnv1a(std::to_string(kBuilderVersion) + "/" + std::to_string(core::kSnapshotVersion) + "/" +
-                std::to_string(core::kSceneFormatVersion),
+                std::to_string(core::kSceneFormatVersion) + "/" + std::to_string(options.retina_vertices),
             h);
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return d.name + "-" + buf;
 }
 
+std::string case_cache_key(const std::string& path) { return case_cache_key(read_case_text(path)); }
+
 LoadedCase load_case(const std::string& path, const CaseLoadOptions& options) {
-  const core::SceneDescription d = load_scene_file(path);
+  return load_case(read_case_text(path), options);
+}
+
+LoadedCase load_case(const CaseText& text, const CaseLoadOptions& options) {
+  const core::SceneDescription d = case_description(text, options);
   core::BuildOptions build;
   build.textures = options.textures;
   if (options.cache_dir.empty()) return LoadedCase{core::build_scene(d, build), false, ""};
 
-  const std::string file = (std::filesystem::path(options.cache_dir) / (case_cache_key(path) + ".snap")).string();
+  const std::string file = (std::filesystem::path(options.cache_dir) / (case_cache_key(text, options) + ".snap")).string();
   std::error_code ec;
   if (std::filesystem::is_regular_file(file, ec)) {
     build.settle = false;

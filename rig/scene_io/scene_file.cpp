@@ -275,6 +275,11 @@ core::CriterionKind criterion_kind(Tab& t) {
 }  // namespace
 
 core::SceneDescription parse_scene(std::string_view text, const std::string& file) {
+  return parse_scene(text, file, nullptr, nullptr);
+}
+
+core::SceneDescription parse_scene(std::string_view text, const std::string& file, const std::string* library_text,
+                                   std::string* library_text_used) {
   const toml::table doc = parse_toml(text, file);
   Tab root(doc, "", file);
   core::SceneDescription d;
@@ -357,7 +362,9 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     if (!library.empty()) {
       const std::filesystem::path base = std::filesystem::path(file).parent_path();
       const std::string lib_path = (base / library).string();
-      const std::string lib_text = read_file(lib_path, file, m->line("library"), m->key("library"));
+      const std::string lib_text =
+          library_text ? *library_text : read_file(lib_path, file, m->line("library"), m->key("library"));
+      if (library_text_used) *library_text_used = lib_text;
       const toml::table lib = parse_toml(lib_text, lib_path);
       Tab lt(lib, "", lib_path);
       int version = 0;

@@ -35,5 +35,10 @@ class SceneError : public std::runtime_error {
 core::SceneDescription load_scene_file(const std::string& path);
 // `file_name` is used in messages and to resolve the materials library (its directory).
 core::SceneDescription parse_scene(std::string_view text, const std::string& file_name);
+// The same with the materials library's text given (a recording carries it, so a replay does not
+// depend on the library file as it is today); nullptr reads the file as above. `library_text_used`
+// (optional) receives the library text that was used ("" when the case names none).
+core::SceneDescription parse_scene(std::string_view text, const std::string& file_name, const std::string* library_text,
+                                   std::string* library_text_used = nullptr);
 
 }  // namespace vitreo::scene_io

@@ -2,65 +2,61 @@
 // From the physics state to the renderer's FrameScene, without making physics wait or allocate.
 //
 // Physics copies what the picture needs (vertex positions; triangle lists only when the topology
-// changed) into a preallocated slot of a triple buffer at display rate; the render service thread
-// turns the newest slot into a FrameScene (normals, uv, meshes for instruments and the choroid) and
-// hands it to the render thread. This is the thesis' double-buffered vertex state (ch. 2.3.2),
-// with a third buffer so neither side ever waits.
+// changed; instruments, light, burns, fluid level) into a preallocated slot of a triple buffer at
+// display rate; the render service thread turns the newest slot into a FrameScene and hands it to
+// the render thread. This is the thesis' double-buffered vertex state (ch. 2.3.2), with a third
+// buffer so neither side ever waits.
+//
+// What a case looks like (CaseVisuals, built on the loader thread when the case is loaded): the eye
+// model's static meshes (sclera, choroid with the choroid map, iris, lens, ciliary processes, the
+// three port cannulas), the retina's vessel map, and which surface is retina, gel or membrane. The
+// render thread adds per frame: the retina with its vessel alpha map over the choroid, coloured by
+// how far each vertex has lifted off the wall (detached = greyish), membranes whitish, gel hazy,
+// laser burns where the instrument system recorded them, the fluid–gas level, the instruments.
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "core/anatomy/eye_model.hpp"
 #include "rig/runtime/triple_buffer.hpp"
 #include "rig/session/simulation_model.hpp"
+#include "rig/session/view_snapshot.hpp"
 #include "vitreo/render/frame_scene.hpp"
 
 namespace vitreo::rig {
 
-struct SurfaceSnapshot {
-  std::vector<float> xyz;            // 3 per vertex slot (dead slots included; not indexed)
-  std::vector<float> rest_xyz;       // for texture coordinates; copied with the indices
-  std::vector<std::uint32_t> indices;
-  std::uint64_t topology_version = ~std::uint64_t{0};
-  bool is_retina = false;
+struct CaseVisuals {
+  int index = 0;
+  std::string name, title;
+  core::EyeModel eye;                       // wall (detachment distance) and fundus mapping
+  std::vector<render::Mesh> statics;        // static meshes, ids 1..99
+  render::ImagePtr retina_texture;          // vessel colour + alpha (fundus plane)
+  std::vector<render::MaterialKind> surface_material;  // per world surface
+  core::Vec3 focus_mm = core::Vec3::Zero();
+  float globe_radius_mm = 12.0f;
+  float camera_z_mm = 4.0f;                 // wide-angle view: just behind the lens
+  std::vector<Port> ports;                  // instrument pivots by the eye's port index
 };
 
-struct ViewSnapshot {
-  std::uint64_t step = 0;
-  double t_s = 0.0;
-  std::vector<SurfaceSnapshot> surfaces;
-  struct Instrument {
-    bool present = false;
-    bool inserted = false;
-    float tip[3] = {};
-    float axis[3] = {};
-    int tool_type = 0;
-  };
-  Instrument instruments[4];
-  bool light_active = false;
-  float light_apex[3] = {};
-  float light_axis[3] = {};
-  float light_half_angle_deg = 40.0f;
-  double zoom = 1.0;
-  double light_level = 0.7;
-};
+// Loader thread: the case's look. Needs the scene's textures (load with textures on).
+std::unique_ptr<CaseVisuals> build_case_visuals(const PreparedCase& c);
+// Loader thread: gives the case its three view snapshots, sized for its surfaces.
+void prepare_view_snapshots(PreparedCase& c);
 
-// Sizes every slot for the model's capacities, so later copies never allocate.
-void reserve_view_snapshots(const SimulationModel& model, runtime::TripleBuffer<ViewSnapshot>& buffer);
-// Physics thread: copies the model's current state into `out` (no allocation after reserve).
-void capture_view(const SimulationModel& model, std::uint64_t step, double t_s, ViewSnapshot& out);
+// Physics thread: copies the model's current state into `out` (no allocation: when `out` was sized
+// for another case it is swapped with one of the case's spares first; without one nothing is
+// copied and false is returned).
+bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSnapshot& out);
 
-// Render service thread: builds the FrameScene of a snapshot. Keeps the static meshes and the
-// geometry versions between calls.
+// Render service thread: builds the FrameScene of a snapshot. Keeps the last case's static meshes
+// and the geometry versions between calls.
 class FrameBuilder {
  public:
-  FrameBuilder(double globe_radius_mm, std::vector<Port> ports);
   render::FrameScene build(const ViewSnapshot& snapshot);
 
  private:
-  double globe_radius_mm_;
-  std::vector<Port> ports_;
-  render::MeshGeometryPtr choroid_;
-  std::vector<std::uint64_t> versions_;
+  std::uint64_t serial_ = 0;
   std::uint64_t frame_ = 0;
 };
 

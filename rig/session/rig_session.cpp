@@ -6,15 +6,22 @@
 #include <cstdio>
 #include <cstring>
 #include <algorithm>
+#include <array>
+#include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <optional>
 
+#include "core/scene/snapshot.hpp"
 #include "rig/runtime/clock.hpp"
 #include "rig/runtime/thread_harness.hpp"
 #include "rig/telemetry/commands.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "rig/telemetry/terminal_commands.hpp"
+#include "rig/session/case_switcher.hpp"
 #include "rig/session/frame_source.hpp"
+#include "rig/session/snapshot_writer.hpp"
 #include "vitreo/render/render_thread.hpp"
 
 namespace vitreo::rig {
@@ -79,6 +86,20 @@ telemetry::DeviceInput session_end_marker(std::uint64_t steps) {
   return in;
 }
 
+telemetry::DeviceInput case_input(int index) {
+  telemetry::DeviceInput in;
+  in.device_kind = kCaseKind;
+  in.n_values = 1;
+  in.values[0] = static_cast<double>(index);
+  return in;
+}
+
+std::string hex(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
 telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
   telemetry::DeviceInput in;
   in.device_kind = kCommandKind;
@@ -92,18 +113,42 @@ telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
 }  // namespace
 
 SessionSummary run_session(const SessionConfig& config) {
-  SimulationModel model(config.model);
+  if (config.model.cases.empty()) throw std::invalid_argument("run_session: no case to run");
+  CaseSwitcher switcher(config.model.cases, config.model.load, config.render);
+  // The first case is loaded here, before any thread starts (a bad case stops the session now).
+  std::unique_ptr<PreparedCase> first = switcher.load_now(config.model.first_case);
+  const std::uint64_t start_hash = first->start_hash;
+  SessionSummary summary;
+  summary.case_name = first->scene->description.name;
+  summary.case_title = first->scene->description.title;
+  summary.case_file = config.model.cases[static_cast<std::size_t>(config.model.first_case)].file_name;
+  summary.case_from_cache = first->from_cache;
+  summary.instruments = describe_instruments(*first);
+  SimulationModel model(config.model, std::move(first));
+
   telemetry::TelemetryPublisher publisher(telemetry::PublisherConfig{config.lcm_url, 4096});
   telemetry::TelemetrySource& physics_out = publisher.add_source("physics");
   telemetry::TelemetrySource& devices_out = publisher.add_source("devices");
   telemetry::CommandServer commands(publisher.lcm());
 
+  std::string snapshot_dir = config.snapshot_dir;
+  if (snapshot_dir.empty()) {
+    snapshot_dir = config.record_path.empty() ? std::string(".")
+                                              : std::filesystem::path(config.record_path).parent_path().string();
+    if (snapshot_dir.empty()) snapshot_dir = ".";
+  }
+  // Twice the first case's state: room for cuts and a larger case without allocating.
+  SnapshotWriter snapshots(snapshot_dir, 2 * core::encode_snapshot(model.world(), summary.case_name).size() + (1u << 20));
+  commands.set_snapshot_folder(snapshots.folder());
+
   std::unique_ptr<telemetry::Recorder> recorder;
   if (!config.record_path.empty()) {
     telemetry::RecordingHeader header;
-    header.case_id = config.case_id;
-    header.config_name = "vitreo";
-    header.config_text = config.config_text;
+    header.case_id = summary.case_name;
+    header.config_name = "vitreo-cases";
+    header.config_text = encode_case_list(config.model);
+    header.snapshot_ref = summary.case_file;
+    header.snapshot_hash = hex(start_hash);
     header.step_period_us = static_cast<std::int32_t>(config.model.dt_s * 1e6);
     recorder = std::make_unique<telemetry::Recorder>(config.record_path, header);
   }
@@ -111,7 +156,7 @@ SessionSummary run_session(const SessionConfig& config) {
   // Rendering: created first so an EGL failure stops the session before any device starts.
   std::unique_ptr<render::RenderThread> renderer;
   runtime::TripleBuffer<ViewSnapshot> views;
-  std::optional<FrameBuilder> frames;
+  FrameBuilder frames;
   if (config.render) {
     render::RenderThreadOptions ro;
     ro.render.eye_width = config.eye_width;
@@ -119,19 +164,23 @@ SessionSummary run_session(const SessionConfig& config) {
     ro.png_dir = config.png_dir;
     ro.png_every_frames = config.png_every_frames;
     renderer = std::make_unique<render::RenderThread>(ro);
-    reserve_view_snapshots(model, views);
-    frames.emplace(config.model.scene.globe_radius_mm, config.model.ports);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));
 
-  DeviceHub hub(config.devices, &devices_out);
-  SessionSummary summary;
+  std::vector<DeviceSpec> devices = config.devices;
+  if (config.adapt_devices) config.adapt_devices(model.current_case(), devices);
+  DeviceHub hub(devices, &devices_out);
   runtime::SteadyClock wall;
   runtime::HarnessConfig harness_config;
   harness_config.loop.period_ns = static_cast<std::int64_t>(config.model.dt_s * 1e9);
   harness_config.max_steps = config.steps;
   harness_config.physics_realtime = config.realtime;
   const runtime::FixedStepLoop* loop = nullptr;  // the harness's loop; set before start()
+  std::unique_ptr<PreparedCase> retiring;        // a replaced case waiting for room in the ring
+  // Case switches for the summary: fixed slots written by physics, read after it stopped.
+  constexpr std::size_t kMaxSwitchLog = 64;
+  std::array<std::pair<std::uint64_t, int>, kMaxSwitchLog> switch_log{};
+  std::size_t switches = 0;
 
   runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
@@ -142,17 +191,43 @@ SessionSummary run_session(const SessionConfig& config) {
       if (recorder) recorder->push(stamped);
       model.apply(stamped);
     };
+    // A case the loader finished: installed now, at the step boundary (a pointer move), recorded.
+    if (std::unique_ptr<PreparedCase> ready = switcher.take()) {
+      const int index = ready->index;
+      model.stage(std::move(ready));
+      consume(case_input(index));
+      if (switches < kMaxSwitchLog) switch_log[switches] = {k, index};
+      ++switches;
+      if (!retiring) retiring = model.take_retired();
+    }
+    if (retiring && !switcher.retire(retiring)) { /* ring full: try again next step */ }
     telemetry::AcceptedCommand cmd;
-    while (commands.poll(cmd)) consume(command_input(cmd));
-    // What the command server validates the next commands against (one case for now).
+    while (commands.poll(cmd)) {
+      consume(command_input(cmd));
+      const int target = switcher.pending() >= 0 ? switcher.pending() : model.case_index();
+      switch (cmd.code) {
+        case telemetry::CommandCode::NextCase: switcher.request(std::min(target + 1, model.case_count() - 1)); break;
+        case telemetry::CommandCode::PreviousCase: switcher.request(std::max(target - 1, 0)); break;
+        // Reset: the case the operator is in — or on the way to, when a switch is still loading.
+        case telemetry::CommandCode::Reset: switcher.request(target); break;
+        case telemetry::CommandCode::SaveSnapshot:
+          (void)snapshots.capture(model.world(), model.scene().description.name, cmd.arg, k);
+          break;
+        default: break;
+      }
+    }
+    // What the command server validates the next commands against: the case a pending switch
+    // leads to counts as current, so "next, next" walks two cases.
     telemetry::CommandContext& context = commands.context().write_slot();
     context.paused = model.paused();
-    context.case_index = 0;
-    context.case_count = 1;
+    context.case_index = switcher.pending() >= 0 ? switcher.pending() : model.case_index();
+    context.case_count = model.case_count();
     commands.context().publish();
     hub.take_new(consume);
     if (k + 1 == config.steps) consume(session_end_marker(config.steps));
     const core::StepReport report = model.step();
+    // Per-step metrics (core/metrics: scores, criteria) observe the model here, after the step and
+    // before its events are published.
     for (const auto& slot : model.instruments()) {
       if (slot.frozen) {
         ++summary.frozen_steps;
@@ -168,6 +243,8 @@ SessionSummary run_session(const SessionConfig& config) {
     for (const auto& e : model.instrument_system().events()) {
       physics_out.push(instrument_event(e, step, t_s));
       ++summary.instrument_events;
+      if (e.kind == core::InstrumentEventKind::kGrasp) ++summary.grasps;
+      if (e.kind == core::InstrumentEventKind::kLaserBurn) ++summary.burns;
     }
     if (k % 4 == 0) {  // instrument state at 250 Hz (CHANNELS.md)
       const auto& slots = model.instruments();
@@ -176,8 +253,7 @@ SessionSummary run_session(const SessionConfig& config) {
       }
     }
     if (renderer && (k % view_every == 0 || k + 1 == config.steps)) {
-      capture_view(model, k, t_s, views.write_slot());
-      views.publish();
+      if (capture_view(model, k, t_s, views.write_slot())) views.publish();
     }
     if (loop && (k + 1) % 250 == 0) {  // physics timing at 4 Hz, cumulative over the session
       telemetry::PhysicsTiming t = telemetry::timing_item(loop->stats(), k, harness_config.loop.period_ns);
@@ -189,23 +265,31 @@ SessionSummary run_session(const SessionConfig& config) {
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();
     publisher.handle_incoming();
+    commands.pump_local();  // commands typed on the terminal: the same validation and queue
   });
   if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
+  harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(!harness.physics_done()); });
+  harness.add_service("snapshots", std::chrono::milliseconds(20), [&] { snapshots.service(); });
   std::uint64_t last_view = ~std::uint64_t{0};
   auto render_latest = [&] {
     if (!views.update()) return;
     const ViewSnapshot& v = views.read_slot();
-    if (v.step == last_view) return;
+    if (v.step == last_view || !v.visuals) return;
     last_view = v.step;
-    renderer->publish(frames->build(v));
+    renderer->publish(frames.build(v));
   };
   if (renderer) {
     harness.add_service("render", std::chrono::milliseconds(static_cast<int>(1000.0 / config.display_hz)), render_latest);
   }
 
+  std::unique_ptr<telemetry::TerminalCommands> terminal;
+  if (config.command_fd >= 0) terminal = std::make_unique<telemetry::TerminalCommands>(config.command_fd, commands, config.command_echo);
+
   hub.start();
   harness.start();
+  if (terminal) terminal->start();
   harness.wait_physics();
+  if (terminal) terminal->stop();
   harness.stop();
   hub.stop();
   if (recorder) recorder->close();
@@ -219,6 +303,14 @@ SessionSummary run_session(const SessionConfig& config) {
     summary.renderer = renderer->context_description();
     if (auto err = renderer->error()) throw std::runtime_error("rendering failed: " + *err);
   }
+  for (std::size_t i = 0; i < std::min(switches, kMaxSwitchLog); ++i) {
+    const int index = switch_log[i].second;
+    summary.cases_loaded.push_back("step " + std::to_string(switch_log[i].first) + ": " +
+                                   config.model.cases[static_cast<std::size_t>(index)].file_name);
+  }
+  if (switcher.failures() > 0) summary.cases_loaded.push_back("load failures: " + std::to_string(switcher.failures()) + " (last: " + switcher.last_error() + ")");
+  snapshots.service();
+  summary.snapshots = snapshots.written();
 
   summary.steps = harness.loop().stats().steps;
   summary.simulated_s = static_cast<double>(summary.steps) * config.model.dt_s;
@@ -244,9 +336,23 @@ SessionSummary run_session(const SessionConfig& config) {
   return summary;
 }
 
-ReplaySummary replay_session(const std::string& path, const ModelConfig& model_config, bool real_time) {
+ReplaySummary replay_session(const std::string& path, const ModelConfig& base, bool real_time) {
   const telemetry::Recording rec = telemetry::read_recording(path);
+  // The cases as they were recorded: their texts are in the header, not read from scenes/.
+  ModelConfig model_config = base;
+  if (rec.header.config_name != "vitreo-cases") {
+    throw std::runtime_error(path + ": recording has no case list (config '" + rec.header.config_name +
+                             "'); it was made by an older vitreo");
+  }
+  decode_case_list(rec.header.config_text, model_config);
+  model_config.load.textures = false;  // physics only
   SimulationModel model(model_config);
+  const std::string start = hex(model.current_case().start_hash);
+  if (!rec.header.snapshot_hash.empty() && rec.header.snapshot_hash != start) {
+    throw std::runtime_error(path + ": the recorded case '" + rec.header.case_id + "' rebuilds to start state " + start +
+                             ", the recording started from " + rec.header.snapshot_hash +
+                             " (a different build of the simulation?)");
+  }
   telemetry::InputCursor cursor(rec);
   std::uint64_t steps = 0;
   std::uint64_t inputs = 0;
@@ -277,6 +383,7 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& model_c
   out.state_hash = model.state_hash();
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.case_id = rec.header.case_id;
+  for (const auto& c : model_config.cases) out.cases.push_back(c.file_name);
   return out;
 }
 

@@ -2,6 +2,7 @@
 // A whole session: devices → physics (fixed step) → telemetry and recording, on separate threads
 // (rig/runtime/README.md has the diagram). Physics only ever touches wait-free mailboxes.
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <optional>
 #include <string>
@@ -14,17 +15,25 @@
 namespace vitreo::rig {
 
 struct SessionConfig {
-  ModelConfig model;
+  ModelConfig model;  // the case list (the first case is model.cases[model.first_case])
   std::vector<DeviceSpec> devices;
   std::uint64_t steps = 5000;
   std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
   std::string record_path;  // empty: no recording
-  std::string case_id = "retina-cap";
-  std::string config_text;  // stored in the recording's header
+  // Operator "save snapshot NAME" writes NAME.snapshot here (core/scene/snapshot format); empty:
+  // the folder of record_path, else the current folder.
+  std::string snapshot_dir;
+  // Operator commands typed on a terminal: lines read from this descriptor on their own thread
+  // (telemetry::TerminalCommands), acks printed to command_echo. -1: none.
+  int command_fd = -1;
+  std::FILE* command_echo = stdout;
   bool realtime = false;    // SCHED_FIFO/mlockall/affinity for physics where permitted
   // Scripted actions at given steps, run on the physics thread (hardware-in-the-loop tests pull a
   // simulated cable with it). Must be quick and wait-free, like everything on that thread.
   std::function<void(std::uint64_t step, DeviceHub& hub)> on_step;
+  // Called once the first case is loaded, before the devices start: lets simulated devices follow
+  // the case's anatomy (the main job's scripted hand aims at where this case's tissue lies).
+  std::function<void(const PreparedCase& first, std::vector<DeviceSpec>& devices)> adapt_devices;
 
   // Stereo microscope frames (EGL, headless here): rendered on their own thread from snapshots
   // physics takes at display rate; PNGs of every png_every_frames-th frame and of the last one.
@@ -36,6 +45,12 @@ struct SessionConfig {
 };
 
 struct SessionSummary {
+  std::string case_name, case_file, case_title;  // the first case
+  std::string instruments;                       // its instruments and their trackers
+  bool case_from_cache = false;
+  std::vector<std::string> cases_loaded;         // every switch and reset, "step N: name"
+  std::vector<std::string> snapshots;            // files written by "save snapshot"
+  std::uint64_t grasps = 0, burns = 0;           // instrument events of note
   std::uint64_t steps = 0;
   double simulated_s = 0.0;
   runtime::LoopStats loop;
@@ -52,7 +67,13 @@ struct SessionSummary {
 };
 
 // Runs a live session to completion (config.steps) and returns its summary. Throws on setup errors
-// (bad LCM URL, unopenable recording, bad device script).
+// (bad LCM URL, unopenable recording, bad device script, a first case that does not load).
+//
+// Operator commands (LCM VITREO_COMMAND): next/previous case and reset ask the loader thread for a
+// case; it is built there (from the cache folder when it has the settled start) and installed by
+// physics at the next step boundary with one pointer move — recorded as a kCaseKind input, so a
+// replay switches at the same step. Save snapshot copies the world into a preallocated buffer at
+// the step boundary; a writer thread stores it atomically as <snapshot_dir>/NAME.snapshot.
 SessionSummary run_session(const SessionConfig& config);
 
 struct ReplaySummary {
@@ -61,10 +82,13 @@ struct ReplaySummary {
   std::uint64_t state_hash = 0;
   double wall_s = 0.0;
   std::string case_id;
+  std::vector<std::string> cases;  // names of the recording's case list
 };
 
 // Replays a recording through the same model as fast as possible (simulated clock), or at real
-// time when `real_time` is set. The model must be configured as the live session was.
+// time when `real_time` is set. The cases (their file and library texts, resolution overrides) come
+// from the recording, not from scenes/; `model` supplies the rest (pedal mapping, calibration, the
+// cache folder). Throws std::runtime_error when the rebuilt start differs from the recorded one.
 ReplaySummary replay_session(const std::string& recording_path, const ModelConfig& model, bool real_time = false);
 
 }  // namespace vitreo::rig

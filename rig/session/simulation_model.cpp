@@ -2,43 +2,104 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+#include <cstdio>
+#include <stdexcept>
 
 #include "core/common/state_hasher.hpp"
 
 namespace vitreo::rig {
 
-SimulationModel::SimulationModel(const ModelConfig& config)
-    : config_(config), scene_(core::build_retina_cap(config.scene)), pedals_(config.pedals) {
-  build_instruments();
+// ---- The case list as text ----------------------------------------------------------------------
+// "vitreo-cases 1\n" then "key value\n" lines, then per case "case <name bytes> <text bytes>
+// <library bytes>\n" followed by exactly those bytes. Lengths, not delimiters: the texts are free.
+
+std::string encode_case_list(const ModelConfig& c) {
+  std::string out = "vitreo-cases 1\n";
+  out += "first_case " + std::to_string(c.first_case) + "\n";
+  out += "retina_vertices " + std::to_string(c.load.retina_vertices) + "\n";
+  out += "texture_size_px " + std::to_string(c.load.texture_size_px) + "\n";
+  for (const auto& t : c.cases) {
+    out += "case " + std::to_string(t.file_name.size()) + " " + std::to_string(t.text.size()) + " " +
+           std::to_string(t.library_text.size()) + "\n";
+    out += t.file_name;
+    out += t.text;
+    out += t.library_text;
+  }
+  return out;
 }
 
-void SimulationModel::build_instruments() {
-  core::InstrumentSceneOptions options;
-  for (const Port& p : config_.ports) options.ports_mm.push_back(p.position_mm);
-  options.retina_surface = scene_.retina;
-  options.macula_mm = core::Vec3(0.0, 0.0, -config_.scene.globe_radius_mm);
-  if (scene_.detachment_force != core::kNone) {
-    // The detachment drains through its centre (a break there), under gas.
-    core::DrainageSite site;
-    site.local_force = scene_.detachment_force;
-    const double c = config_.scene.detachment_center_deg * std::numbers::pi / 180.0;
-    site.break_point_mm = config_.scene.globe_radius_mm * core::Vec3(-std::sin(c), 0.0, -std::cos(c));
-    options.drainage_sites.push_back(site);
+void decode_case_list(const std::string& text, ModelConfig& config) {
+  auto fail = [](const std::string& why) { throw std::runtime_error("recording's case list: " + why); };
+  std::size_t at = 0;
+  auto line = [&]() {
+    const std::size_t nl = text.find('\n', at);
+    if (nl == std::string::npos) fail("truncated");
+    std::string l = text.substr(at, nl - at);
+    at = nl + 1;
+    return l;
+  };
+  if (line() != "vitreo-cases 1") fail("not a vitreo case list (or a newer version)");
+  ModelConfig out = config;
+  out.cases.clear();
+  while (at < text.size()) {
+    const std::string l = line();
+    long long a = 0, b = 0, c = 0;
+    char key[32] = {};
+    if (std::sscanf(l.c_str(), "case %lld %lld %lld", &a, &b, &c) == 3) {
+      if (a < 0 || b < 0 || c < 0 || static_cast<std::size_t>(a + b + c) > text.size() - at) fail("case text truncated");
+      scene_io::CaseText t;
+      t.file_name = text.substr(at, static_cast<std::size_t>(a));
+      t.text = text.substr(at + static_cast<std::size_t>(a), static_cast<std::size_t>(b));
+      t.library_text = text.substr(at + static_cast<std::size_t>(a + b), static_cast<std::size_t>(c));
+      at += static_cast<std::size_t>(a + b + c);
+      out.cases.push_back(std::move(t));
+    } else if (std::sscanf(l.c_str(), "%31s %lld", key, &a) == 2) {
+      const std::string k = key;
+      if (k == "first_case") out.first_case = static_cast<int>(a);
+      else if (k == "retina_vertices") out.load.retina_vertices = static_cast<int>(a);
+      else if (k == "texture_size_px") out.load.texture_size_px = static_cast<int>(a);
+      else fail("unknown key '" + k + "'");
+    } else {
+      fail("bad line '" + l + "'");
+    }
   }
-  std::vector<core::InstrumentDescription> instruments;
-  for (std::size_t i = 0; i < config_.instruments.size() && i < config_.ports.size(); ++i) {
-    core::InstrumentDescription d;
-    d.kind = config_.instruments[i];
-    d.port = static_cast<std::uint32_t>(i);
-    instruments.push_back(d);
+  if (out.cases.empty()) fail("no cases");
+  if (out.first_case < 0 || out.first_case >= static_cast<int>(out.cases.size())) fail("first case out of range");
+  config = std::move(out);
+}
+
+// ---- The model ------------------------------------------------------------------------------------
+
+SimulationModel::SimulationModel(const ModelConfig& config)
+    : SimulationModel(config, prepare_case(config.cases, config.first_case, config.load)) {}
+
+SimulationModel::SimulationModel(const ModelConfig& config, std::unique_ptr<PreparedCase> first)
+    : config_(config), pedals_(config.pedals) {
+  if (!first) throw std::invalid_argument("SimulationModel: no case");
+  install(std::move(first));
+  case_loads_ = 0;  // the first case is the start, not a switch
+}
+
+void SimulationModel::install(std::unique_ptr<PreparedCase> c) {
+  retired_ = std::move(case_);
+  case_ = std::move(c);
+  // A case starts with the instruments out, the pedals released and the eye at rest.
+  pedals_ = PedalMapper(config_.pedals);
+  for (auto& slot : instruments_) {  // instruments out; a lost tracker stays lost
+    const bool frozen = slot.frozen;
+    slot = InstrumentSlot{};
+    slot.frozen = frozen;
   }
-  std::vector<std::uint32_t> surfaces;
-  for (std::uint32_t s = 0; s < scene_.world.surface_count(); ++s) surfaces.push_back(s);
-  system_.reset();
-  topology_ = std::make_unique<core::TopologyAdapter>(scene_.world, surfaces, surfaces);
-  system_ = std::make_unique<core::InstrumentSystem>(scene_.world, options, instruments);
-  system_->set_topology(topology_.get());
+  eye_rotation_ = core::Quat::Identity();
+  eye_tracked_ = false;
+  paused_ = false;
+  ++case_loads_;
+}
+
+int SimulationModel::selected_tool() const {
+  const auto n = case_->tools.size();
+  if (n == 0) return -1;
+  return static_cast<int>(pedals_.controls().instrument_changes % n);
 }
 
 bool SimulationModel::apply(const telemetry::DeviceInput& in) {
@@ -51,21 +112,23 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
   bool ok = false;
   if (in.device_kind == kSessionEndKind) {
     ok = true;
+  } else if (in.device_kind == kCaseKind && in.n_values >= 1) {
+    const int index = static_cast<int>(in.values[0]);
+    if (index >= 0 && index < case_count()) {
+      if (staged_ && staged_->index == index) {
+        install(std::move(staged_));
+      } else {
+        install(prepare_case(config_.cases, index, config_.load));
+      }
+      ok = true;
+    }
   } else if (in.device_kind == kCommandKind && in.n_values >= 2) {
-    // Codes follow telemetry::CommandCode; case changes and snapshots are the session's business.
+    // Codes follow telemetry::CommandCode. Case changes, reset and snapshots are carried out by the
+    // session (a case is loaded off the physics thread; its arrival is a kCaseKind input).
     switch (static_cast<int>(in.values[0])) {
       case 3: paused_ = true; break;   // Pause
       case 4: paused_ = false; break;  // Resume
-      case 5:                          // Reset: the case as it was loaded, instruments out
-        system_.reset();
-        topology_.reset();
-        scene_ = core::build_retina_cap(config_.scene);
-        build_instruments();
-        pedals_ = PedalMapper(config_.pedals);
-        instruments_ = {};
-        eye_rotation_ = core::Quat::Identity();
-        ++resets_;
-        break;
+      case 5: ++resets_; break;        // Reset: requested here, the reload arrives as kCaseKind
       case 7: wireframe_ = !wireframe_; break;
       case 8: labels_ = !labels_; break;
       case 9: zoom_override_ = in.values[1]; break;
@@ -79,22 +142,20 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
     }
     ok = true;
   } else if (DecodedTracker t; decode_tracker(in, t)) {
-    if (t.instrument_id >= 0 && t.instrument_id < static_cast<int>(instruments_.size())) {
+    if (t.instrument_id >= 0 && t.instrument_id < kTrackedInstruments) {
       InstrumentSlot& slot = instruments_[static_cast<std::size_t>(t.instrument_id)];
-      const int port = t.instrument_id < static_cast<int>(config_.ports.size()) ? t.instrument_id : -1;
-      if (port >= 0 && !slot.frozen) {
+      if (!slot.frozen) {
         InstrumentPose pose;
         // In the fixture frame: the instrument system applies the eye's rotation itself.
-        ok = map_through_port(t.pose, config_.ports[static_cast<std::size_t>(port)], core::Quat::Identity(),
-                              config_.calibration, pose);
+        ok = map_through_port(t.pose, case_->tracker_ports[t.instrument_id], core::Quat::Identity(), config_.calibration, pose);
         if (ok) {
           slot.present = true;
-          slot.port = port;
+          slot.port = t.instrument_id + 1;  // the eye's ports: 0 infusion, 1 working_1, 2 working_2
           slot.tool_type = t.tool_type;
           slot.pose = pose;
         }
       } else {
-        ok = port >= 0;  // a frozen instrument ignores its (late) samples
+        ok = true;  // a frozen instrument ignores its (late) samples
       }
     }
   } else if (PedalReading p; decode_pedals(in, p)) {
@@ -114,38 +175,51 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
 core::StepReport SimulationModel::step() {
   if (paused_) return {};
   const SurgicalControls& c = pedals_.controls();
-  for (std::uint32_t i = 0; i < system_->instrument_count(); ++i) {
-    const InstrumentSlot& slot = instruments_[i];
+  core::InstrumentSystem& sys = *case_->system;
+  const int tool = selected_tool();
+  const double vacuum = pedals_.mapping().vacuum_max_mmhg > 0.0 ? c.vacuum_mmhg / pedals_.mapping().vacuum_max_mmhg : 0.0;
+  auto tracked = [&](const InstrumentSlot& slot) {
+    // A frozen instrument (tracker lost) holds its last pose and lets go of nothing it holds.
     core::InstrumentInput in;
-    if (slot.present) {
-      // A frozen instrument (tracker lost) holds its last pose and lets go of nothing it holds.
-      in.present = slot.pose.inserted;
-      in.tip_fixture_mm = slot.pose.tip_mm;
-      in.axis_fixture = slot.pose.axis;
-      in.twist_rad = slot.pose.roll_rad;
-      in.actuation = slot.pose.actuation;
-    } else if (config_.instruments[i] == core::InstrumentKind::kLightPipe) {
-      // Untracked light pipe: held through its port, 6 mm in, toward the posterior pole.
-      const core::Vec3 port = config_.ports[i].position_mm;
-      const core::Vec3 target(0.0, 0.0, -0.6 * config_.scene.globe_radius_mm);
-      in = core::InstrumentInput::through_port(port, (target - port).normalized(), 6.0);
+    in.present = slot.pose.inserted;
+    in.tip_fixture_mm = slot.pose.tip_mm;
+    in.axis_fixture = slot.pose.axis;
+    in.twist_rad = slot.pose.roll_rad;
+    in.actuation = slot.pose.actuation;
+    return in;
+  };
+  for (std::uint32_t i = 0; i < sys.instrument_count(); ++i) {
+    core::InstrumentInput in;
+    if (static_cast<int>(i) == case_->light_pipe) {
+      const InstrumentSlot& slot = instruments_[kLightPipeTracker];
+      if (slot.present) {
+        in = tracked(slot);
+      } else {
+        // Untracked light pipe: held 6 mm into its port, aimed at the case's region of interest.
+        const core::Vec3 port = case_->tracker_ports[kLightPipeTracker].position_mm;
+        in = core::InstrumentInput::through_port(port, (case_->focus_mm - port).normalized(), 6.0);
+      }
+    } else if (static_cast<int>(i) == tool && instruments_[kToolTracker].present) {
+      in = tracked(instruments_[kToolTracker]);
     } else {
-      in.present = false;
+      in.present = false;  // the tools not in the hand are outside the eye
     }
-    const double vacuum = pedals_.mapping().vacuum_max_mmhg > 0.0 ? c.vacuum_mmhg / pedals_.mapping().vacuum_max_mmhg : 0.0;
     in.pedal = std::clamp(vacuum, 0.0, 1.0);
     in.trigger = c.laser_fire;
     in.light_power_mw = 5.0 + 10.0 * c.light_level;
-    (void)system_->set_input(i, in);  // refused input (non-finite) leaves the last one in place
+    (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
-  system_->set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
+  sys.set_air_infusion(c.air_infusion);
+  sys.set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
-  return system_->step(config_.dt_s).tissue;
+  return sys.step(config_.dt_s).tissue;
 }
 
 std::uint64_t SimulationModel::state_hash() const {
   core::StateHasher h;
-  h.add_u64(scene_.world.state_hash());
+  h.add_u64(world().state_hash());
+  h.add_u64(static_cast<std::uint64_t>(case_->index));
+  h.add_u64(case_loads_);
   h.add_u64(steps_);
   h.add_u64(applied_);
   h.add_u64(resets_);
@@ -165,6 +239,7 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.zoom);
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
+  h.add_u64(c.air_infusion ? 1u : 0u);
   h.add_double(eye_rotation_.w());
   h.add_double(eye_rotation_.x());
   h.add_double(eye_rotation_.y());

@@ -10,11 +10,13 @@
 #include <optional>
 #include <vector>
 
-#include "core/anatomy/retina_cap.hpp"
+#include <string>
+
 #include "core/instruments/instrument_system.hpp"
-#include "core/instruments/topology_adapter.hpp"
 #include "rig/input/controls.hpp"
 #include "rig/input/port_pivot.hpp"
+#include "rig/scene_io/case_loader.hpp"
+#include "rig/session/case_runtime.hpp"
 #include "rig/session/device_inputs.hpp"
 
 namespace vitreo::rig {
@@ -28,18 +30,24 @@ inline constexpr std::int8_t kSessionEndKind = 5;
 // An accepted operator command (values[0] = telemetry::CommandCode, values[1] = its value): pause,
 // reset or zoom change the session, so they are recorded and replayed like device inputs.
 inline constexpr std::int8_t kCommandKind = 6;
+// A case (re)loaded at this step (values[0] = index in the case list): next/previous case and reset
+// take effect when the loader thread has the case ready, so the step they land on is recorded.
+inline constexpr std::int8_t kCaseKind = 7;
 
 struct ModelConfig {
-  core::RetinaCapOptions scene;
+  // The session's cases (scenes/*.toml as text, so a recording can carry them); first_case starts.
+  std::vector<scene_io::CaseText> cases;
+  int first_case = 0;
+  scene_io::CaseLoadOptions load;  // cache folder, resolution overrides
   double dt_s = 1e-3;
   PedalMapping pedals;
   TrackerCalibration calibration;
-  std::vector<Port> ports;  // instrument i goes through port i (if present)
-  // What each tracked instrument is (index = tracker's instrument id = port); the light pipe in the
-  // second port, aimed at the posterior pole, stands in for the surgeon's other hand unless a
-  // tracker drives it.
-  std::vector<core::InstrumentKind> instruments = {core::InstrumentKind::kForceps, core::InstrumentKind::kLightPipe};
 };
+
+// The case list and overrides as one text (stored in a recording's header), and back. decode throws
+// std::runtime_error for a text that is not one.
+std::string encode_case_list(const ModelConfig& config);
+void decode_case_list(const std::string& text, ModelConfig& config);
 
 struct InstrumentSlot {
   bool present = false;
@@ -51,11 +59,21 @@ struct InstrumentSlot {
 
 class SimulationModel {
  public:
+  // Loads config.first_case in place (allocates, may settle), or starts from one already prepared.
   explicit SimulationModel(const ModelConfig& config);
+  SimulationModel(const ModelConfig& config, std::unique_ptr<PreparedCase> first);
 
   // Applies one recorded input. Returns false for an input it refuses (unknown kind, non-finite
   // values, bad quaternion): the refusal is counted and the state is unchanged.
+  // A kCaseKind input installs the staged case when it is the one named, else loads it in place
+  // (a replay), so both reach the same state.
   bool apply(const telemetry::DeviceInput& in);
+  // Live sessions: a case prepared on another thread, installed by the next kCaseKind input for its
+  // index (wait-free: a pointer move). take_retired() hands back the case it replaced, so its memory
+  // is freed off the physics thread.
+  void stage(std::unique_ptr<PreparedCase> prepared) { staged_ = std::move(prepared); }
+  bool has_staged() const { return staged_ != nullptr; }
+  std::unique_ptr<PreparedCase> take_retired() { return std::move(retired_); }
   // One physics step (skipped while paused). Returns the core's report.
   core::StepReport step();
   bool paused() const { return paused_; }
@@ -65,10 +83,19 @@ class SimulationModel {
   double zoom_override() const { return zoom_override_; }
   std::uint64_t resets() const { return resets_; }
 
-  core::TissueWorld& world() { return scene_.world; }
-  const core::InstrumentSystem& instrument_system() const { return *system_; }
-  const core::TissueWorld& world() const { return scene_.world; }
-  const core::RetinaCapScene& scene() const { return scene_; }
+  core::TissueWorld& world() { return case_->scene->world; }
+  const core::InstrumentSystem& instrument_system() const { return *case_->system; }
+  const core::TissueWorld& world() const { return case_->scene->world; }
+  const core::Scene& scene() const { return *case_->scene; }
+  const PreparedCase& current_case() const { return *case_; }
+  // The view-snapshot spares of the current case (capture_view swaps them in; nothing else).
+  PreparedCase& mutable_case() { return *case_; }
+  int case_index() const { return case_->index; }
+  int case_count() const { return static_cast<int>(config_.cases.size()); }
+  const ModelConfig& config() const { return config_; }
+  std::uint64_t case_loads() const { return case_loads_; }
+  // The hand-held tool tracker 0 drives now (index into current_case().tools; -1: none).
+  int selected_tool() const;
   const SurgicalControls& controls() const { return pedals_.controls(); }
   const std::array<InstrumentSlot, 4>& instruments() const { return instruments_; }
   const core::Quat& eye_rotation() const { return eye_rotation_; }
@@ -80,11 +107,10 @@ class SimulationModel {
 
  private:
   ModelConfig config_;
-  void build_instruments();
+  void install(std::unique_ptr<PreparedCase> c);
 
-  core::RetinaCapScene scene_;
-  std::unique_ptr<core::TopologyAdapter> topology_;
-  std::unique_ptr<core::InstrumentSystem> system_;
+  std::unique_ptr<PreparedCase> case_, staged_, retired_;
+  std::uint64_t case_loads_ = 0;
   bool eye_tracked_ = false;  // an eyeball fixture reports the eye's rotation
   PedalMapper pedals_;
   std::array<InstrumentSlot, 4> instruments_{};

@@ -155,7 +155,27 @@ CommandServer::~CommandServer() {
   if (sub_) lcm_.unsubscribe(sub_);
 }
 
-void CommandServer::on_command(const vitreo_lcm::operator_command_t& command) {
+void CommandServer::pump_local() {
+  LocalCommand in;
+  while (local_in_.try_pop(in)) {
+    vitreo_lcm::operator_command_t cmd{};
+    cmd.utime_us = wall_time_us();
+    cmd.source = text(in.source);
+    cmd.seq = in.seq;
+    cmd.command = in.command;
+    cmd.value = in.value;
+    cmd.arg = text(in.arg);
+    const Verdict v = handle(cmd);
+    LocalAck ack;
+    ack.seq = in.seq;
+    ack.command = in.command;
+    ack.accepted = v.accepted;
+    copy_text(ack.reason, v.reason);
+    (void)local_acks_.try_push(ack);  // a terminal that stopped reading acks loses them, nothing else
+  }
+}
+
+Verdict CommandServer::handle(const vitreo_lcm::operator_command_t& command) {
   const vitreo_lcm::operator_command_t* cmd = &command;
   Verdict v;
   auto last = last_seq_.find(cmd->source);
@@ -176,6 +196,9 @@ void CommandServer::on_command(const vitreo_lcm::operator_command_t& command) {
     copy_text(a.arg, cmd->arg);
     a.seq = cmd->seq;
     if (!queue_.try_push(a)) v = {false, "physics command queue is full"};
+    if (v.accepted && a.code == CommandCode::SaveSnapshot && !snapshot_folder_.empty()) {
+      v.reason = "-> " + snapshot_folder_ + "/" + cmd->arg + ".snapshot";
+    }
   }
   vitreo_lcm::command_ack_t ack;
   ack.utime_us = wall_time_us();
@@ -192,6 +215,7 @@ void CommandServer::on_command(const vitreo_lcm::operator_command_t& command) {
     ++refused_;
     spdlog::warn("command {} #{} from '{}' refused: {}", command_name(cmd->command), cmd->seq, cmd->source, v.reason);
   }
+  return v;
 }
 
 }  // namespace vitreo::telemetry

@@ -69,6 +69,23 @@ struct AcceptedCommand {
   std::int64_t seq = 0;
 };
 
+// A command typed on the rig's own terminal (rig/session/terminal_commands.hpp): handed to the
+// telemetry thread through a ring, validated there exactly like one from LCM, acknowledged on LCM
+// and back to the terminal.
+struct LocalCommand {
+  std::int8_t command = 0;
+  double value = 0;
+  char arg[65] = {};
+  char source[32] = {};
+  std::int64_t seq = 0;
+};
+struct LocalAck {
+  std::int64_t seq = 0;
+  std::int8_t command = 0;
+  bool accepted = false;
+  char reason[192] = {};
+};
+
 class CommandServer {
  public:
   // Subscribes to VITREO_COMMAND on `lcm`; acks are published on the same object.
@@ -81,11 +98,22 @@ class CommandServer {
   runtime::TripleBuffer<CommandContext>& context() noexcept { return context_; }
   bool poll(AcceptedCommand& out) noexcept { return queue_.try_pop(out); }
 
+  // Where "save snapshot NAME" files go: an accepted SAVE_SNAPSHOT's ack says "→ FOLDER/NAME.snapshot"
+  // in its reason field. Before the telemetry thread starts.
+  void set_snapshot_folder(std::string folder) { snapshot_folder_ = std::move(folder); }
+
+  // Terminal side (one producer thread): false when the ring is full.
+  bool submit(const LocalCommand& cmd) noexcept { return local_in_.try_push(cmd); }
+  bool poll_ack(LocalAck& out) noexcept { return local_acks_.try_pop(out); }
+  // Telemetry thread: validates and queues the submitted commands (the same path as LCM's).
+  void pump_local();
+
   std::uint64_t accepted() const noexcept { return accepted_; }
   std::uint64_t refused() const noexcept { return refused_; }
 
  private:
-  void on_command(const vitreo_lcm::operator_command_t& cmd);
+  void on_command(const vitreo_lcm::operator_command_t& cmd) { (void)handle(cmd); }
+  Verdict handle(const vitreo_lcm::operator_command_t& cmd);
   struct Dispatch {
     CommandServer* self;
     void operator()(const vitreo_lcm::operator_command_t& cmd) { self->on_command(cmd); }
@@ -95,7 +123,10 @@ class CommandServer {
   lcm::Subscription* sub_ = nullptr;
   runtime::TripleBuffer<CommandContext> context_;
   runtime::SpscRing<AcceptedCommand> queue_;
+  runtime::SpscRing<LocalCommand> local_in_{32};
+  runtime::SpscRing<LocalAck> local_acks_{32};
   std::map<std::string, std::int64_t> last_seq_;  // per source: replays and reordering are refused
+  std::string snapshot_folder_;
   std::uint64_t accepted_ = 0;
   std::uint64_t refused_ = 0;
 };

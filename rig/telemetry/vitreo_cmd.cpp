@@ -57,7 +57,8 @@ int send(lcm::LCM& lc, AckWaiter& waiter, const std::string& line, int timeout_m
     return 2;
   }
   if (waiter.ack.accepted) {
-    std::printf("%s: accepted\n", command_name(waiter.ack.command));
+    std::printf("%s: accepted%s%s\n", command_name(waiter.ack.command), waiter.ack.reason.empty() ? "" : " ",
+                waiter.ack.reason.c_str());
     return 0;
   }
   std::printf("%s: refused: %s\n", command_name(waiter.ack.command), waiter.ack.reason.c_str());

@@ -755,7 +755,13 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
       glActiveTexture(GL_TEXTURE1);
       glBindTexture(GL_TEXTURE_2D, d.gpu->burn_texture);
     }
+    // Wireframe (operator toggle): the deformable tissue's triangles as lines, to see the mesh.
+    const bool lines = scene.wireframe && d.mesh &&
+                       (d.mesh->material == MaterialKind::Retina || d.mesh->material == MaterialKind::Membrane ||
+                        d.mesh->material == MaterialKind::Gel);
+    if (lines) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     draw(d);
+    if (lines) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   };
 
   // Translucent layers back to front, from the midpoint between the eyes (the base is small
@@ -765,8 +771,15 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     const Vec3 c = d.mesh->model.transform_point((d.gpu->bbox_min + d.gpu->bbox_max) * 0.5f);
     d.sort_distance = length(c - mid);
   }
-  std::stable_sort(translucent.begin(), translucent.end(),
-                   [](const DrawItem& a, const DrawItem& b) { return a.sort_distance > b.sort_distance; });
+  // The retina is the back layer of the eye's interior (it lies on the choroid): every other
+  // translucent layer (membranes on it, gel, the detached retina's neighbours) is on its vitreous
+  // side, so it is drawn first whatever its bounding box says (a large cap's centre sits nearer the
+  // camera than a small membrane lying on it).
+  std::stable_sort(translucent.begin(), translucent.end(), [](const DrawItem& a, const DrawItem& b) {
+    const bool ra = a.mesh->material == MaterialKind::Retina, rb = b.mesh->material == MaterialKind::Retina;
+    if (ra != rb) return ra;
+    return a.sort_distance > b.sort_distance;
+  });
 
   for (int e = 0; e < 2; ++e) {
     eye_view = &views.eye[e];

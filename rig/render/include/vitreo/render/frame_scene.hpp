@@ -129,6 +129,7 @@ struct FrameScene {
   float globe_radius_mm = 12.0f;  // inner radius of the globe: bounds the haze and the gas bubble
   float ambient = 0.025f;         // dim ambient (stray light through the sclera and pupil)
   float haze_density_per_mm = 0.02f;  // infusion/vitreous scattering
+  bool wireframe = false;         // deformable tissue (retina, membranes, gel) drawn as triangle edges
 };
 
 /// Per-kind defaults used when a Mesh leaves opacity / casts_shadow unset.

@@ -1,0 +1,138 @@
+#include "rig/session/case_runtime.hpp"
+
+#include <numbers>
+#include <sstream>
+
+#include "core/common/status.hpp"
+
+namespace vitreo::rig {
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+core::Vec3 on_wall(const core::EyeModel& eye, const core::FundusLocation& at) {
+  return eye.wall_point(at.polar_deg * kDeg, at.azimuth_deg * kDeg);
+}
+
+// Where the surgeon will look first: the pathology the case is about.
+core::Vec3 region_of_interest(const core::Scene& s) {
+  const auto& d = s.description;
+  if (!d.tears.empty()) return on_wall(s.eye, d.tears.front().center);
+  if (!d.membranes.empty()) return on_wall(s.eye, d.membranes.front().center);
+  if (!d.detachments.empty()) return on_wall(s.eye, d.detachments.front().center);
+  for (const auto& g : d.guides) {
+    if (!g.points.empty()) return on_wall(s.eye, g.points.front());
+    if (g.around.empty()) return on_wall(s.eye, g.center);
+  }
+  return s.eye.fovea_mm;
+}
+
+const core::SclerotomyPort* find_port(const core::EyeModel& eye, const char* name) {
+  for (const auto& p : eye.ports) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+// The pivot of an instrument in a sclerotomy: the middle of the cannula through the wall.
+Port pivot_of(const core::SclerotomyPort& p) {
+  Port out;
+  out.position_mm = 0.5 * (p.outer_mm + p.inner_mm);
+  out.outward = -p.axis;
+  return out;
+}
+
+}  // namespace
+
+bool instrument_kind(const std::string& name, core::InstrumentKind& out) {
+  using K = core::InstrumentKind;
+  if (name == "vitrector") out = K::kVitrector;
+  else if (name == "forceps") out = K::kForceps;
+  else if (name == "scissors") out = K::kScissors;
+  else if (name == "pick") out = K::kPick;
+  else if (name == "laser") out = K::kEndolaser;
+  else if (name == "light_pipe") out = K::kLightPipe;
+  else if (name == "backflush") out = K::kDrainageNeedle;  // soft-tip flute needle
+  else return false;                                      // "infusion": a cannula, not held
+  return true;
+}
+
+std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>& cases, int index,
+                                           const scene_io::CaseLoadOptions& options) {
+  if (index < 0 || index >= static_cast<int>(cases.size())) {
+    throw core::InvalidArgument("case index " + std::to_string(index) + " outside the case list (" +
+                                std::to_string(cases.size()) + " cases)");
+  }
+  auto out = std::make_unique<PreparedCase>();
+  out->index = index;
+  scene_io::LoadedCase loaded = scene_io::load_case(cases[static_cast<std::size_t>(index)], options);
+  out->from_cache = loaded.from_cache;
+  out->scene = std::make_unique<core::Scene>(std::move(loaded.scene));
+  core::Scene& s = *out->scene;
+  out->start_hash = s.world.state_hash();
+  out->focus_mm = region_of_interest(s);
+
+  const core::SclerotomyPort* infusion = find_port(s.eye, "infusion");
+  const core::SclerotomyPort* w1 = find_port(s.eye, "working_1");
+  const core::SclerotomyPort* w2 = find_port(s.eye, "working_2");
+  if (!infusion || !w1 || !w2) throw core::InvalidArgument("case " + s.description.name + ": the eye has no three-port layout");
+  out->tracker_ports[kToolTracker] = pivot_of(*w1);
+  out->tracker_ports[kLightPipeTracker] = pivot_of(*w2);
+
+  core::InstrumentSceneOptions o;
+  o.ports_mm = {pivot_of(*infusion).position_mm, out->tracker_ports[0].position_mm, out->tracker_ports[1].position_mm};
+  o.retina_surface = s.retina;
+  o.macula_mm = s.eye.fovea_mm;
+  o.anatomy.has_lens = true;
+  o.anatomy.lens_center_mm = core::Vec3(0.0, 0.0, s.eye.lens_center_z_mm);
+  const auto& a = s.description.anatomy;
+  o.anatomy.lens_semi_axes_mm = core::Vec3(0.5 * a.lens_diameter_mm, 0.5 * a.lens_diameter_mm, 0.5 * a.lens_thickness_mm);
+  // Subretinal fluid drains through the break: the case's tear when it has one, else the centre.
+  for (std::size_t i = 0; i < s.detachment_forces.size() && i < s.description.detachments.size(); ++i) {
+    core::DrainageSite site;
+    site.local_force = s.detachment_forces[i];
+    site.break_point_mm = s.description.tears.empty() ? on_wall(s.eye, s.description.detachments[i].center)
+                                                      : on_wall(s.eye, s.description.tears.front().center);
+    o.drainage_sites.push_back(site);
+  }
+  std::vector<core::InstrumentDescription> instruments;
+  bool light = false;
+  for (const auto& name : s.description.instruments) {
+    core::InstrumentKind k;
+    if (!instrument_kind(name, k)) continue;
+    if (k == core::InstrumentKind::kLightPipe) {
+      light = true;
+      continue;
+    }
+    out->tools.push_back(k);
+    core::InstrumentDescription d;
+    d.kind = k;
+    d.port = 1;
+    instruments.push_back(d);
+  }
+  if (light) {
+    core::InstrumentDescription d;
+    d.kind = core::InstrumentKind::kLightPipe;
+    d.port = 2;
+    out->light_pipe = static_cast<int>(instruments.size());
+    instruments.push_back(d);
+  }
+  std::vector<std::uint32_t> surfaces;
+  for (std::uint32_t i = 0; i < s.world.surface_count(); ++i) surfaces.push_back(i);
+  out->topology = std::make_unique<core::TopologyAdapter>(s.world, surfaces, surfaces);
+  out->system = std::make_unique<core::InstrumentSystem>(s.world, o, instruments);
+  out->system->set_topology(out->topology.get());
+  return out;
+}
+
+std::string describe_instruments(const PreparedCase& c) {
+  std::ostringstream ss;
+  ss << "tracker 0 (working_1): ";
+  for (std::size_t i = 0; i < c.tools.size(); ++i) ss << (i ? ", " : "") << core::to_string(c.tools[i]);
+  if (c.tools.empty()) ss << "none";
+  ss << " (instrument switch cycles); tracker 1 (working_2): " << (c.light_pipe >= 0 ? "light pipe" : "none");
+  return ss.str();
+}
+
+}  // namespace vitreo::rig

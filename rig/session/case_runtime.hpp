@@ -1,0 +1,65 @@
+#pragma once
+// One case ready to step: the built and settled core::Scene (a scenes/*.toml case), the instruments
+// the case offers going through its sclerotomy ports, and how the rig's trackers map onto them.
+//
+// Preparing one allocates and may take a second (parse, build, settle or restore from the cache), so
+// a live session does it on a loader thread and hands the result to physics at a step boundary
+// (rig_session.cpp); a replay does it in place when it reaches the recorded switch.
+//
+// Tracker mapping (the surgeon's two hands):
+//   tracker instrument 0 → the hand-held tool: the case's instruments other than the light pipe and
+//                          the infusion, in the order the case lists them, through port "working_1";
+//                          the pedal's instrument-change switch cycles through them
+//   tracker instrument 1 → the light pipe through "working_2" (when no tracker drives it, it is held
+//                          there aimed at the case's region of interest)
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/instruments/instrument_system.hpp"
+#include "core/instruments/topology_adapter.hpp"
+#include "core/scene/scene_builder.hpp"
+#include "rig/input/port_pivot.hpp"
+#include "rig/scene_io/case_loader.hpp"
+#include "rig/session/view_snapshot.hpp"
+
+namespace vitreo::rig {
+
+inline constexpr int kToolTracker = 0;
+inline constexpr int kLightPipeTracker = 1;
+inline constexpr int kTrackedInstruments = 2;
+
+struct PreparedCase {
+  int index = 0;  // in the session's case list
+  std::unique_ptr<core::Scene> scene;
+  std::unique_ptr<core::TopologyAdapter> topology;
+  std::unique_ptr<core::InstrumentSystem> system;
+  std::vector<core::InstrumentKind> tools;  // system instruments 0..tools.size()-1
+  int light_pipe = -1;                      // system instrument index of the light pipe (-1: none)
+  Port tracker_ports[kTrackedInstruments];  // pivot of each tracked instrument
+  core::Vec3 focus_mm = core::Vec3::Zero(); // the case's region of interest (light, microscope)
+  std::uint64_t start_hash = 0;             // world state hash at the settled start
+  bool from_cache = false;
+
+  // For the picture (live sessions with rendering; replays leave them empty): a serial unique per
+  // load, the case's static meshes and textures (owned by the session), and three view snapshots
+  // sized for this case's surfaces, swapped into the view triple buffer by physics (frame_source).
+  std::uint64_t serial = 0;
+  const CaseVisuals* visuals = nullptr;
+  std::vector<ViewSnapshot> spare_views;
+  std::size_t spare_views_used = 0;
+};
+
+// The instrument kind of a scene file's instrument name; false for those that are not tracked
+// instruments ("infusion").
+bool instrument_kind(const std::string& name, core::InstrumentKind& out);
+
+// Loads case `index` of `cases` and builds its instruments. Throws like scene_io::load_case.
+std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>& cases, int index,
+                                           const scene_io::CaseLoadOptions& options);
+
+// One line describing the case's instruments and their ports/trackers, for summaries and --help.
+std::string describe_instruments(const PreparedCase& c);
+
+}  // namespace vitreo::rig

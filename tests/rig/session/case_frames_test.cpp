@@ -1,0 +1,440 @@
+// Every case in scenes/ as the surgeon sees it: the real SimulationModel on the case (a coarse
+// retina and small textures to stay quick), the light pipe and the case's first tool placed at fixed
+// poses through their trackers and ports, captured at a step boundary (capture_view), turned into a
+// FrameScene (FrameBuilder) and rendered as a small stereo frame on Mesa through surfaceless EGL.
+//
+// Each frame is compared with a checked-in golden (tolerance-based, the metric is printed; see
+// golden/README.md to regenerate), and checked against facts that do not depend on the golden: the
+// lit spot is far brighter than the unlit periphery, the retina's vessel map is what that spot shows
+// (taking the texture away changes it), a detached case shows its lifted retina greyer than the same
+// frame with the detachment shading off, and an attached case has no lifted retina at all.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "rig/scene_io/case_loader.hpp"
+#include "rig/session/case_switcher.hpp"
+#include "rig/session/frame_source.hpp"
+#include "rig/session/simulation_model.hpp"
+#include "synthetic_scene.hpp"
+#include "vitreo/render/egl_context.hpp"
+#include "vitreo/render/image_compare.hpp"
+#include "vitreo/render/png_io.hpp"
+#include "vitreo/render/renderer.hpp"
+
+using namespace vitreo;
+namespace vr = vitreo::render;
+
+namespace {
+
+constexpr int kW = 160, kH = 128;
+const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
+
+std::vector<std::string> case_names() {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(kScenes)) {
+    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") out.push_back(e.path().stem().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+struct Rgb {
+  double r = 0, g = 0, b = 0;
+  double luma() const { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
+  double spread() const { return std::max({r, g, b}) - std::min({r, g, b}); }  // 0 = grey
+};
+
+Rgb patch(const vr::Image& img, vr::Vec2 p, int k) {
+  Rgb s;
+  int n = 0;
+  for (int y = static_cast<int>(p.y) - k; y <= static_cast<int>(p.y) + k; ++y) {
+    for (int x = static_cast<int>(p.x) - k; x <= static_cast<int>(p.x) + k; ++x) {
+      if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
+      const std::uint8_t* q = &img.rgba[(static_cast<std::size_t>(y) * img.width + x) * 4];
+      s.r += q[0], s.g += q[1], s.b += q[2];
+      ++n;
+    }
+  }
+  if (n > 0) s.r /= n, s.g /= n, s.b /= n;
+  return s;
+}
+
+telemetry::DeviceInput tracker(int id, const core::Vec3& tip, double actuation) {
+  telemetry::DeviceInput in;
+  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
+  in.n_values = 11;
+  in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
+  in.values[3] = 1.0;  // orientation: the shaft is rebuilt from the port through the tip
+  in.values[7] = actuation;
+  in.values[8] = 1.0;
+  in.values[9] = id;
+  in.values[10] = 3;
+  return in;
+}
+
+class CaseFrames : public ::testing::TestWithParam<std::string> {
+ protected:
+  static void SetUpTestSuite() {
+    vr::EglOptions o;
+    o.honour_environment = false;
+    context_ = new vr::EglContext(o);
+    renderer_ = new vr::StereoRenderer(vr::RenderSettings{kW, kH, 512, 512});
+  }
+  static void TearDownTestSuite() {
+    delete renderer_;
+    delete context_;
+    renderer_ = nullptr;
+    context_ = nullptr;
+  }
+  static vr::Image render(const vr::FrameScene& s) {
+    vr::StereoFrame f;
+    renderer_->render(s, f);
+    return f.side_by_side();
+  }
+  static vr::StereoFrame render_stereo(const vr::FrameScene& s) {
+    vr::StereoFrame f;
+    renderer_->render(s, f);
+    return f;
+  }
+
+  static vr::EglContext* context_;
+  static vr::StereoRenderer* renderer_;
+};
+vr::EglContext* CaseFrames::context_ = nullptr;
+vr::StereoRenderer* CaseFrames::renderer_ = nullptr;
+
+// What is stored and compared: the stereo frame reduced 2× (box filter) and quantised to steps of 8,
+// which keeps each golden a few kilobytes; the tolerance below is far above what that costs.
+vr::Image reduced(const vr::Image& full) {
+  vr::Image out;
+  out.width = full.width / 2;
+  out.height = full.height / 2;
+  out.rgba.resize(static_cast<std::size_t>(out.width) * out.height * 4);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      for (int k = 0; k < 4; ++k) {
+        int sum = 0;
+        for (int dy = 0; dy < 2; ++dy) {
+          for (int dx = 0; dx < 2; ++dx) sum += full.rgba[(static_cast<std::size_t>(2 * y + dy) * full.width + 2 * x + dx) * 4 + k];
+        }
+        const int mean = (sum + 2) / 4;
+        out.rgba[(static_cast<std::size_t>(y) * out.width + x) * 4 + k] = static_cast<std::uint8_t>(k == 3 ? 255 : std::min(255, (mean + 4) / 8 * 8));
+      }
+    }
+  }
+  return out;
+}
+
+void expect_golden(const vr::Image& full, const std::string& name) {
+  const vr::Image actual = reduced(full);
+  const std::string golden = std::string(VITREO_CASE_GOLDEN_DIR) + "/" + name + ".png";
+  const char* update = std::getenv("VITREO_UPDATE_GOLDENS");
+  if (update != nullptr && std::string(update) == "1") {
+    vr::write_png(golden, actual);
+    std::printf("updated golden %s\n", golden.c_str());
+    return;
+  }
+  ASSERT_TRUE(std::filesystem::exists(golden)) << "missing golden " << golden << " (regenerate: VITREO_UPDATE_GOLDENS=1)";
+  const vr::ImageDiff d = vr::compare_images(actual, vr::read_png(golden), 24);
+  std::printf("golden %s: %s\n", name.c_str(), d.summary().c_str());
+  ::testing::Test::RecordProperty("rmse_" + name, std::to_string(d.rmse));
+  if (!(d.same_size && d.rmse <= 3.0 && d.fraction_over <= 0.015)) {
+    mkdir("golden-actual", 0755);
+    const std::string out = "golden-actual/" + name + ".png";
+    vr::write_png(out, actual);
+    ADD_FAILURE() << "golden " << name << " differs: " << d.summary() << " (limits rmse<=3, over(24)<=1.5%); actual written to "
+                  << out;
+  }
+}
+
+}  // namespace
+
+TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
+  const std::string name = GetParam();
+  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/" + name + ".toml")};
+  scene_io::CaseLoadOptions load;
+  load.retina_vertices = 2000;
+  load.texture_size_px = 0;  // the case's own (1024 px): peripheral vessels vanish below that
+  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  rig::CaseSwitcher loader(cases, load, /*visuals=*/true);  // owns the case's look for the test
+  rig::ModelConfig mc;
+  mc.cases = cases;
+  mc.load = load;
+  rig::SimulationModel model(mc, loader.load_now(0));
+  const rig::PreparedCase& c = model.current_case();
+
+  // Fixed poses: the light pipe 6 mm into working_2 aimed at the case's region of interest, the
+  // first tool 5 mm into working_1 aimed at it too, jaws open.
+  const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
+  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
+  ASSERT_TRUE(model.apply(tracker(rig::kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 5.0 * (c.focus_mm - tp).normalized(), 0.0)));
+  for (int i = 0; i < 3; ++i) model.step();
+
+  rig::ViewSnapshot view;
+  ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
+  rig::FrameBuilder builder;
+  const vr::FrameScene scene = builder.build(view);
+  ASSERT_TRUE(scene.light_pipe.has_value()) << "the case offers a light pipe";
+  const vr::StereoFrame frame = render_stereo(scene);
+  expect_golden(frame.side_by_side(), name);
+
+  // The lit spot (where the light pipe's axis meets the fundus) against the periphery of the image.
+  const vr::Image left = frame.eye(0);
+  const vr::Vec2 spot = render::testing::project_to_pixel(scene, 0, vr::Vec3{float(c.focus_mm.x()), float(c.focus_mm.y()), float(c.focus_mm.z())}, kW, kH);
+  ASSERT_TRUE(spot.x >= 0 && spot.x < kW && spot.y >= 0 && spot.y < kH) << "the region of interest is in view";
+  const Rgb lit = patch(left, spot, 4);
+  double dark = 1e9;
+  for (vr::Vec2 corner : {vr::Vec2{4, 4}, vr::Vec2{kW - 5.0f, 4}, vr::Vec2{4, kH - 5.0f}, vr::Vec2{kW - 5.0f, kH - 5.0f}}) {
+    dark = std::min(dark, patch(left, corner, 3).luma());
+  }
+  std::printf("%s: lit spot luma %.1f (r %.0f g %.0f b %.0f), darkest corner %.1f\n", name.c_str(), lit.luma(), lit.r, lit.g, lit.b, dark);
+  EXPECT_GT(lit.luma(), 30.0);
+  EXPECT_GT(lit.luma(), 3.0 * dark + 10.0) << "only the light pipe lights the interior";
+
+  // The vessel map is on the retina: the same frame without it differs in the lit spot.
+  vr::FrameScene plain = scene;
+  for (auto& m : plain.meshes) {
+    if (m.material == vr::MaterialKind::Retina) m.texture = nullptr;
+  }
+  const vr::Image left_plain = render_stereo(plain).eye(0);
+  int changed = 0, lit_pixels = 0;
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 4;
+      if (0.2126 * left.rgba[i] + 0.7152 * left.rgba[i + 1] + 0.0722 * left.rgba[i + 2] < 25.0) continue;
+      ++lit_pixels;
+      int d = 0;
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(int(left.rgba[i + k]) - int(left_plain.rgba[i + k])));
+      changed += d > 12;
+    }
+  }
+  std::printf("%s: %d of %d lit pixels change without the vessel map\n", name.c_str(), changed, lit_pixels);
+  // Vessels are sparse in the periphery (the horseshoe-tear cases look there): ≥ 0.5 % of the lit
+  // pixels; posterior views change by 10–30 %.
+  EXPECT_GT(changed, std::max(30, lit_pixels / 200)) << "the retina shows its fundus texture (vessels, disc) where it is lit";
+
+  // Detachment: the most lifted retina vertex in the lit cone, against the same frame without
+  // the detachment shading.
+  const double lift = core::max_retina_lift_mm(model.scene());
+  const vr::Mesh* retina = nullptr;
+  for (const auto& m : scene.meshes) {
+    if (m.material == vr::MaterialKind::Retina) retina = &m;
+  }
+  ASSERT_NE(retina, nullptr);
+  float max_detachment = 0.0f;
+  for (const auto& v : retina->geometry->vertices) max_detachment = std::max(max_detachment, v.detachment);
+  std::printf("%s: retina lifted up to %.2f mm, detachment shading up to %.2f\n", name.c_str(), lift, max_detachment);
+  if (lift < 0.4) {
+    EXPECT_LT(max_detachment, 0.5f) << "an attached retina is not shaded as detached";
+    return;
+  }
+  EXPECT_GT(max_detachment, 0.9f) << "a retina lifted " << lift << " mm is shaded as detached";
+  // Pick the detached vertex (shading ≥ 0.9) nearest the light's axis: it is lit.
+  const vr::Vec3 apex = scene.light_pipe->tip_mm, axis = normalize(scene.light_pipe->direction);
+  vr::Vec3 best{};
+  float best_off = 1e9f;
+  for (const auto& v : retina->geometry->vertices) {
+    if (v.detachment < 0.9f) continue;
+    const vr::Vec3 d = v.position_mm - apex;
+    const float along = dot(d, axis);
+    if (along <= 0) continue;
+    const float off = length(d - axis * along) / along;
+    if (off < best_off) best_off = off, best = v.position_mm;
+  }
+  ASSERT_LT(best_off, 1e8f);
+  vr::FrameScene flat = scene;
+  for (auto& m : flat.meshes) {
+    if (m.material != vr::MaterialKind::Retina) continue;
+    auto g = std::make_shared<vr::MeshGeometry>(*m.geometry);
+    for (auto& v : g->vertices) v.detachment = 0.0f;
+    m.geometry = g;
+    m.geometry_version += 1000000;
+  }
+  const vr::Vec2 px = render::testing::project_to_pixel(scene, 0, best, kW, kH);
+  const Rgb shaded = patch(left, px, 1), unshaded = patch(render_stereo(flat).eye(0), px, 1);
+  std::printf("%s: detached patch spread/luma %.2f vs %.2f without the shading\n", name.c_str(), shaded.spread() / std::max(shaded.luma(), 1.0),
+              unshaded.spread() / std::max(unshaded.luma(), 1.0));
+  EXPECT_LT(shaded.spread() / std::max(shaded.luma(), 1.0), 0.8 * unshaded.spread() / std::max(unshaded.luma(), 1.0))
+      << "detached retina looks greyer";
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryCase, CaseFrames, ::testing::ValuesIn(case_names()),
+                         [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
+
+// The operator's view toggles reach the picture: wireframe draws the tissue's edges, zoom narrows
+// the field (the optic disc moves away from the image centre by the zoom factor).
+TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
+  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_pull_tissue.toml")};
+  scene_io::CaseLoadOptions load;
+  load.retina_vertices = 2000;
+  load.texture_size_px = 0;  // the case's own (1024 px): peripheral vessels vanish below that
+  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  rig::CaseSwitcher loader(cases, load, true);
+  rig::ModelConfig mc;
+  mc.cases = cases;
+  mc.load = load;
+  rig::SimulationModel model(mc, loader.load_now(0));
+  model.step();
+  rig::FrameBuilder builder;
+  auto frame_of = [&] {
+    rig::ViewSnapshot v;
+    EXPECT_TRUE(rig::capture_view(model, 1, 0.001, v));
+    return builder.build(v);
+  };
+  auto command = [&](int code, double value) {
+    telemetry::DeviceInput in;
+    in.device_kind = rig::kCommandKind;
+    in.n_values = 2;
+    in.values[0] = code;
+    in.values[1] = value;
+    ASSERT_TRUE(model.apply(in));
+  };
+  const vr::FrameScene base = frame_of();
+  command(7, 0);  // toggle wireframe
+  const vr::FrameScene wire = frame_of();
+  EXPECT_TRUE(wire.wireframe);
+  const vr::ImageDiff dw = vr::compare_images(render(wire), render(base));
+  std::printf("wireframe vs filled: %s\n", dw.summary().c_str());
+  EXPECT_GT(dw.fraction_over, 0.02) << "the wireframe picture differs visibly";
+  command(7, 0);
+  command(9, 2.0);  // zoom 2×
+  const vr::FrameScene zoomed = frame_of();
+  EXPECT_FLOAT_EQ(zoomed.microscope.zoom, 2.0f);
+  const vr::Vec3 disc{float(model.scene().eye.optic_disc_mm.x()), float(model.scene().eye.optic_disc_mm.y()),
+                      float(model.scene().eye.optic_disc_mm.z())};
+  const vr::Vec2 c0 = render::testing::project_to_pixel(base, 0, disc, kW, kH);
+  const vr::Vec2 c1 = render::testing::project_to_pixel(zoomed, 0, disc, kW, kH);
+  const vr::Vec2 mid{kW / 2.0f, kH / 2.0f};
+  const double r0 = std::hypot(c0.x - mid.x, c0.y - mid.y), r1 = std::hypot(c1.x - mid.x, c1.y - mid.y);
+  EXPECT_NEAR(r1 / r0, 2.0, 0.15) << "zoom 2 doubles image distances from the centre";
+  EXPECT_GT(vr::compare_images(render(zoomed), render(base)).fraction_over, 0.05);
+}
+
+// A laser burn where the aiming beam hit: the endolaser (the laser exercise's tool) fires once
+// through the pedal's laser switch; the burn the instrument system records reaches the frame at
+// that spot and shows whitish there, against the same frame without it.
+TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
+  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_laser_tear.toml")};
+  scene_io::CaseLoadOptions load;
+  load.retina_vertices = 2000;
+  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  rig::CaseSwitcher loader(cases, load, true);
+  rig::ModelConfig mc;
+  mc.cases = cases;
+  mc.load = load;
+  rig::SimulationModel model(mc, loader.load_now(0));
+  const rig::PreparedCase& c = model.current_case();
+  ASSERT_FALSE(c.tools.empty());
+  ASSERT_EQ(c.tools[0], core::InstrumentKind::kEndolaser);
+  // Aim at attached retina beside the fovea (a 0.2 mm burn needs the microscope zoomed in to span
+  // a few pixels of this small frame), with the light pipe on the same spot.
+  const core::Vec3 aim = model.scene().eye.wall_point(8.0 * std::numbers::pi / 180.0, std::numbers::pi);
+  const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
+  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
+  ASSERT_TRUE(model.apply(tracker(rig::kLightPipeTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 8.0 * (aim - tp).normalized(), 0.0)));
+  telemetry::DeviceInput zoom;
+  zoom.device_kind = rig::kCommandKind;
+  zoom.n_values = 2;
+  zoom.values[0] = 9;
+  zoom.values[1] = 10.0;
+  ASSERT_TRUE(model.apply(zoom));
+  model.step();
+  auto pedal = [](int switches) {
+    telemetry::DeviceInput in;
+    in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
+    in.n_values = 7;
+    in.values[0] = 0;  // the vitrectomy pedal
+    in.values[1] = 2;
+    in.values[6] = switches;
+    return in;
+  };
+  rig::FrameBuilder builder;
+  rig::ViewSnapshot before_view;
+  ASSERT_TRUE(rig::capture_view(model, 1, 0.001, before_view));
+  const vr::FrameScene before = builder.build(before_view);
+  ASSERT_TRUE(model.apply(pedal(1 << 1)));  // laser switch (default mapping: switch 1)
+  model.step();
+  ASSERT_TRUE(model.apply(pedal(0)));
+  model.step();
+  ASSERT_EQ(model.instrument_system().burns().size(), 1u) << "one pulse on the rising edge";
+  const core::Vec3 hit = model.instrument_system().burn_position(model.instrument_system().burns()[0]);
+  rig::ViewSnapshot view;
+  ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
+  ASSERT_EQ(view.n_burns, 1u);
+  const vr::FrameScene after = builder.build(view);
+  std::size_t burns = 0;
+  for (const auto& m : after.meshes) burns += m.burns.size();
+  EXPECT_EQ(burns, 1u);
+  vr::FrameScene cleared = after;
+  for (auto& m : cleared.meshes) m.burns.clear();
+  const vr::Vec2 px = render::testing::project_to_pixel(after, 0, vr::Vec3{float(hit.x()), float(hit.y()), float(hit.z())}, kW, kH);
+  ASSERT_TRUE(px.x >= 0 && px.x < kW && px.y >= 0 && px.y < kH);
+  EXPECT_LT((hit - aim).norm(), 1.0) << "the beam went where the laser was aimed";
+  const Rgb with = patch(render_stereo(after).eye(0), px, 1), without = patch(render_stereo(cleared).eye(0), px, 1);
+  std::printf("burn at pixel (%.1f, %.1f): luma %.1f spread %.1f vs %.1f / %.1f without\n", px.x, px.y, with.luma(), with.spread(),
+              without.luma(), without.spread());
+  EXPECT_GT(with.luma(), without.luma() + 15.0) << "the burn is lighter";
+  EXPECT_LT(with.spread() / with.luma(), without.spread() / without.luma()) << "and whiter";
+}
+
+// Fluid–air exchange: the pedal's air switch turns the infusion to air, the flute needle aspirates
+// (vacuum pedal) and the level falls toward its tip; the frame carries that level to the renderer
+// (whose own test, RenderScenes.FluidGasInterfaceIsVisible, shows the interface at the wall; from
+// this view, behind the lens, the meniscus lies outside the field).
+TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
+  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_drain_tear.toml")};
+  scene_io::CaseLoadOptions load;
+  load.retina_vertices = 2000;
+  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  rig::CaseSwitcher loader(cases, load, true);
+  rig::ModelConfig mc;
+  mc.cases = cases;
+  mc.load = load;
+  rig::SimulationModel model(mc, loader.load_now(0));
+  const rig::PreparedCase& c = model.current_case();
+  ASSERT_EQ(c.tools.at(0), core::InstrumentKind::kDrainageNeedle);
+  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
+  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 12.0 * (c.focus_mm - tp).normalized(), 0.0)));
+  auto pedal = [](double vacuum, int switches) {
+    telemetry::DeviceInput in;
+    in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
+    in.n_values = 7;
+    in.values[0] = 0;
+    in.values[1] = 2;
+    in.values[2] = vacuum;
+    in.values[6] = switches;
+    return in;
+  };
+  rig::FrameBuilder builder;
+  model.step();
+  rig::ViewSnapshot v0;
+  ASSERT_TRUE(rig::capture_view(model, 1, 0.001, v0));
+  const vr::FrameScene fluid = builder.build(v0);
+  EXPECT_FALSE(fluid.fluid_gas.has_value()) << "all fluid before the exchange";
+  ASSERT_TRUE(model.apply(pedal(0.0, 1 << 3)));  // air on
+  ASSERT_TRUE(model.apply(pedal(1.0, 0)));       // full aspiration
+  ASSERT_TRUE(model.controls().air_infusion);
+  model.step();
+  const double top = model.instrument_system().fluid_level_z_mm();
+  for (int i = 0; i < 400; ++i) model.step();
+  const double level = model.instrument_system().fluid_level_z_mm();
+  std::printf("fluid level: %.2f mm at the start of the exchange, %.2f mm after 0.4 s of aspiration\n", top, level);
+  EXPECT_NEAR(top - level, 0.4 * 2.0, 0.1) << "falls at the aspiration rate (2 mm/s at full vacuum)";
+  rig::ViewSnapshot v1;
+  ASSERT_TRUE(rig::capture_view(model, 402, 0.402, v1));
+  const vr::FrameScene gas = builder.build(v1);
+  ASSERT_TRUE(gas.fluid_gas.has_value());
+  EXPECT_NEAR(gas.fluid_gas->level_mm, level, 1e-3);
+  EXPECT_NEAR(gas.fluid_gas->up.z, 1.0f, 1e-6f) << "gas rises anteriorly (patient supine)";
+}
