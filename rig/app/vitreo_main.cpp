@@ -117,6 +117,25 @@ const char* kEyeballScript =
 
 std::string lcm_file_url(const fs::path& p) { return "file://" + p.string() + "?mode=w"; }
 
+// --display CARD[:CONNECTOR[:sbs|left|right]]
+vitreo::render::KmsOptions parse_display(const std::string& spec) {
+  vitreo::render::KmsOptions o;
+  const auto a = spec.find(':');
+  o.card = spec.substr(0, a);
+  if (a != std::string::npos) {
+    const auto b = spec.find(':', a + 1);
+    o.connector = spec.substr(a + 1, b == std::string::npos ? std::string::npos : b - a - 1);
+    if (b != std::string::npos) {
+      const std::string layout = spec.substr(b + 1);
+      if (layout == "left") o.layout = vitreo::render::DisplayLayout::LeftEye;
+      else if (layout == "right") o.layout = vitreo::render::DisplayLayout::RightEye;
+      else if (layout != "sbs") throw std::runtime_error("--display " + spec + ": layout must be sbs, left or right");
+    }
+  }
+  if (o.card.empty()) throw std::runtime_error("--display " + spec + ": no card (e.g. /dev/dri/card0)");
+  return o;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -170,6 +189,10 @@ int main(int argc, char** argv) {
   app.add_flag("--commands-from-stdin", commands_from_stdin,
                "read operator commands from stdin even when it is not a terminal (a pipe, a script); when it is a\n"
                "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X");
+  std::vector<std::string> displays;
+  app.add_option("--display", displays,
+                 "show the frames on a rig display through KMS: CARD[:CONNECTOR[:sbs|left|right]], e.g.\n"
+                 "/dev/dri/card0:HDMI-A-1:left (repeatable: one per eyepiece display; default: first connected, side by side)");
   app.add_option("--eye-size", eye_width, "width of each eye's image in pixels (height = 4/5 of it)")
       ->check(CLI::Range(64, 4096));
   try {
@@ -199,6 +222,7 @@ int main(int argc, char** argv) {
                   replay_path.c_str(), r.case_id.c_str(), r.cases.size(), static_cast<unsigned long long>(r.steps),
                   static_cast<unsigned long long>(r.inputs), r.wall_s, static_cast<double>(r.steps) * 1e-3 / r.wall_s,
                   static_cast<unsigned long long>(r.state_hash));
+      for (const auto& line : r.score_lines) std::printf("  score  %s\n", line.c_str());
       return 0;
     }
 
@@ -233,6 +257,8 @@ int main(int argc, char** argv) {
     config.png_dir = (out / "frames").string();
     config.png_every_frames = 10;
     if (render) fs::create_directories(config.png_dir);
+    for (const auto& d : displays) config.displays.push_back(parse_display(d));
+    if (!config.displays.empty() && !render) throw std::runtime_error("--display needs rendering (drop --no-render)");
     if (serial_devices.empty()) {
       const std::string base = "/tmp/vitreo-" + std::to_string(::getpid());
       config.devices = {{"tracker-0", base + "-tracker", 1, 0, ""},
@@ -286,13 +312,16 @@ int main(int argc, char** argv) {
                   static_cast<unsigned long long>(s.frames_rendered), config.eye_width, config.eye_height, s.renderer.c_str(),
                   s.pngs.size(), config.png_dir.c_str(), s.pngs.empty() ? "none" : (s.pngs.back() + "_stereo.png").c_str());
     }
+    for (const auto& line : s.displays) std::printf("  display          %s\n", line.c_str());
+    for (std::size_t i = 0; i < s.score_lines.size(); ++i)
+      std::printf("  %s %s\n", i == 0 ? "score           " : "                ", s.score_lines[i].c_str());
     std::printf("  state hash       %016llx\n", static_cast<unsigned long long>(s.state_hash));
     if (verify_replay) {
       const auto r = vitreo::rig::replay_session(config.record_path, model);
-      const bool same = r.state_hash == s.state_hash;
+      const bool same = r.state_hash == s.state_hash && r.score_lines == s.score_lines;
       std::printf("  replay           %llu steps in %.2f s (%.1fx real time), cases from the recording: %s\n",
                   static_cast<unsigned long long>(r.steps), r.wall_s, static_cast<double>(r.steps) * model.dt_s / r.wall_s,
-                  same ? "identical final state" : "DIFFERENT final state");
+                  same ? "identical final state and score" : "DIFFERENT final state");
       if (!same) return 3;
     }
     return s.rolled_back == 0 ? 0 : 2;

@@ -123,6 +123,7 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   out->topology = std::make_unique<core::TopologyAdapter>(s.world, surfaces, surfaces);
   out->system = std::make_unique<core::InstrumentSystem>(s.world, o, instruments);
   out->system->set_topology(out->topology.get());
+  out->metrics = std::make_unique<core::SessionMetrics>(s, out->system.get());
   return out;
 }
 

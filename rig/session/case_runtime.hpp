@@ -19,6 +19,7 @@
 
 #include "core/instruments/instrument_system.hpp"
 #include "core/instruments/topology_adapter.hpp"
+#include "core/metrics/session_metrics.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "rig/input/port_pivot.hpp"
 #include "rig/scene_io/case_loader.hpp"
@@ -35,6 +36,9 @@ struct PreparedCase {
   std::unique_ptr<core::Scene> scene;
   std::unique_ptr<core::TopologyAdapter> topology;
   std::unique_ptr<core::InstrumentSystem> system;
+  // The case's metrics, criteria and scores (core/metrics), observed after every step; built with
+  // the case so a switch swaps them with it and nothing allocates on the physics thread.
+  std::unique_ptr<core::SessionMetrics> metrics;
   std::vector<core::InstrumentKind> tools;  // system instruments 0..tools.size()-1
   int light_pipe = -1;                      // system instrument index of the light pipe (-1: none)
   Port tracker_ports[kTrackedInstruments];  // pivot of each tracked instrument

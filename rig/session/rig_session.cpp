@@ -110,6 +110,45 @@ telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
   return in;
 }
 
+// The current case's score card as a telemetry item (score() scans the world: call at a low rate).
+telemetry::Score score_item(SimulationModel& model, std::int64_t step, bool final_score) {
+  const core::ScoreCard& card = model.metrics().score();
+  telemetry::Score s;
+  s.step = step;
+  telemetry::copy_text(s.case_id, model.scene().description.name);
+  s.final_score = final_score;
+  s.total = card.total;
+  for (const core::ScoreEntry& e : card.categories) {
+    if (s.n == telemetry::Score::kMaxMetrics) break;
+    telemetry::copy_text(s.name[s.n], e.name);
+    s.value[s.n++] = e.value;
+  }
+  return s;
+}
+
+// The final score and the case's criteria, for the summaries (live and replay print the same lines).
+std::vector<std::string> score_lines(SimulationModel& model) {
+  std::vector<std::string> lines;
+  const core::ScoreCard& card = model.metrics().score();
+  char buf[160];
+  std::string cats;
+  for (const core::ScoreEntry& e : card.categories) {
+    std::snprintf(buf, sizeof buf, "%s%s %.0f", cats.empty() ? "" : ", ", e.name, e.value);
+    cats += buf;
+  }
+  std::snprintf(buf, sizeof buf, "%.0f / 100 (", card.total);
+  lines.push_back(buf + cats + ")");
+  for (const core::CriterionProgress& c : model.metrics().criteria()) {
+    std::snprintf(buf, sizeof buf, "%s%s%s: %.3g (goal %.3g) %s", core::to_string(c.kind), c.target.empty() ? "" : " ",
+                  c.target.c_str(), c.value, c.threshold, c.met ? "met" : "not met");
+    lines.push_back(buf);
+  }
+  const core::SessionTotals& t = model.metrics().totals();
+  std::snprintf(buf, sizeof buf, "iatrogenic events %u", static_cast<unsigned>(t.iatrogenic_events()));
+  lines.push_back(buf);
+  return lines;
+}
+
 }  // namespace
 
 SessionSummary run_session(const SessionConfig& config) {
@@ -163,6 +202,7 @@ SessionSummary run_session(const SessionConfig& config) {
     ro.render.eye_height = config.eye_height;
     ro.png_dir = config.png_dir;
     ro.png_every_frames = config.png_every_frames;
+    ro.displays = config.displays;
     renderer = std::make_unique<render::RenderThread>(ro);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));
@@ -226,8 +266,10 @@ SessionSummary run_session(const SessionConfig& config) {
     hub.take_new(consume);
     if (k + 1 == config.steps) consume(session_end_marker(config.steps));
     const core::StepReport report = model.step();
-    // Per-step metrics (core/metrics: scores, criteria) observe the model here, after the step and
-    // before its events are published.
+    // The model's metrics observed the step; running scores go out at a low rate (score() scans
+    // the world), the final one with the last step.
+    if (k + 1 == config.steps || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
+      physics_out.push(score_item(model, step, k + 1 == config.steps));
     for (const auto& slot : model.instruments()) {
       if (slot.frozen) {
         ++summary.frozen_steps;
@@ -301,6 +343,8 @@ SessionSummary run_session(const SessionConfig& config) {
     summary.scenes_dropped = renderer->scenes_dropped();
     summary.pngs = renderer->pngs_written();
     summary.renderer = renderer->context_description();
+    summary.displays = renderer->display_descriptions();
+    if (renderer->display_errors() > 0) summary.displays.push_back(std::to_string(renderer->display_errors()) + " display(s) dropped (see the log)");
     if (auto err = renderer->error()) throw std::runtime_error("rendering failed: " + *err);
   }
   for (std::size_t i = 0; i < std::min(switches, kMaxSwitchLog); ++i) {
@@ -324,6 +368,7 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.telemetry_published = publisher.published();
   summary.telemetry_dropped = publisher.dropped();
   summary.state_hash = model.state_hash();
+  summary.score_lines = score_lines(model);
   for (std::size_t i = 0; i < hub.device_count(); ++i) {
     const auto& st = hub.stats(i);
     char line[256];
@@ -381,6 +426,7 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
   out.steps = steps;
   out.inputs = inputs;
   out.state_hash = model.state_hash();
+  out.score_lines = score_lines(model);
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.case_id = rec.header.case_id;
   for (const auto& c : model_config.cases) out.cases.push_back(c.file_name);

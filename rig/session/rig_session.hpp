@@ -11,6 +11,7 @@
 #include "rig/runtime/fixed_step_loop.hpp"
 #include "rig/session/device_hub.hpp"
 #include "rig/session/simulation_model.hpp"
+#include "vitreo/render/kms_display.hpp"
 
 namespace vitreo::rig {
 
@@ -42,6 +43,10 @@ struct SessionConfig {
   double display_hz = 30.0;
   std::string png_dir;
   std::uint64_t png_every_frames = 0;
+  // The rig's displays (KMS scan-out, rig/render/kms_display.hpp); empty: headless.
+  std::vector<vitreo::render::KmsOptions> displays;
+  // Running scores on VITREO_SCORE every this many steps (and a final one at the end).
+  std::uint64_t score_every_steps = 1000;
 };
 
 struct SessionSummary {
@@ -64,6 +69,10 @@ struct SessionSummary {
   std::uint64_t frames_rendered = 0, scenes_dropped = 0;
   std::vector<std::string> pngs;           // frames written
   std::string renderer;                    // EGL/GL context in use
+  std::vector<std::string> displays;       // rig displays frames were scanned out to
+  // The final score of the case the session ended in (core/metrics), as published on VITREO_SCORE,
+  // and its criteria ("membrane_removed epiretinal: 0.42 of 0.9"), one line each.
+  std::vector<std::string> score_lines;
 };
 
 // Runs a live session to completion (config.steps) and returns its summary. Throws on setup errors
@@ -83,6 +92,7 @@ struct ReplaySummary {
   double wall_s = 0.0;
   std::string case_id;
   std::vector<std::string> cases;  // names of the recording's case list
+  std::vector<std::string> score_lines;  // the final score, as the live session published it
 };
 
 // Replays a recording through the same model as fast as possible (simulated clock), or at real

@@ -212,7 +212,10 @@ core::StepReport SimulationModel::step() {
   sys.set_air_infusion(c.air_infusion);
   sys.set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
-  return sys.step(config_.dt_s).tissue;
+  const core::StepReport report = sys.step(config_.dt_s).tissue;
+  // Metrics observe every step here, in the model, so a replay measures the same session exactly.
+  (void)case_->metrics->observe(config_.dt_s);
+  return report;
 }
 
 std::uint64_t SimulationModel::state_hash() const {

@@ -88,6 +88,8 @@ class SimulationModel {
   const core::TissueWorld& world() const { return case_->scene->world; }
   const core::Scene& scene() const { return *case_->scene; }
   const PreparedCase& current_case() const { return *case_; }
+  // The current case's metrics; score()/criteria() scan the world, so callers ask at a low rate.
+  core::SessionMetrics& metrics() { return *case_->metrics; }
   // The view-snapshot spares of the current case (capture_view swaps them in; nothing else).
   PreparedCase& mutable_case() { return *case_; }
   int case_index() const { return case_->index; }

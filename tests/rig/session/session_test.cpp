@@ -29,6 +29,7 @@
 #include "rig/telemetry/channels.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
+#include "vitreo_lcm/score_t.hpp"
 
 using namespace vitreo;
 
@@ -83,6 +84,64 @@ TEST(RigSession, ARecordedSessionReplaysToTheSameState) {
   const double speed = static_cast<double>(replay.steps) * 1e-3 / replay.wall_s;
   std::printf("replay of %llu steps: %.1fx real time\n", static_cast<unsigned long long>(replay.steps), speed);
   std::filesystem::remove(config.record_path);
+}
+
+TEST(RigSession, ScoresGoOutOnTelemetryAndTheReplayScoresTheSame) {
+  auto config = small_session("scores", 1500);
+  config.score_every_steps = 500;
+  const std::string log_path = temp_path("scores-telemetry.lcmlog");
+  const rig::SessionSummary live = rig::run_session(config);
+
+  // The telemetry log as lcm-logger would have written it: running scores at 500 and 1000 steps,
+  // the final one with the last step.
+  std::vector<vitreo_lcm::score_t> scores;
+  {
+    lcm::LogFile log(log_path, "r");
+    ASSERT_TRUE(log.good()) << log_path;
+    for (const lcm::LogEvent* ev = log.readNextEvent(); ev != nullptr; ev = log.readNextEvent()) {
+      if (ev->channel != telemetry::kChanScore) continue;
+      vitreo_lcm::score_t m;
+      ASSERT_GE(m.decode(ev->data, 0, static_cast<int>(ev->datalen)), 0);
+      scores.push_back(m);
+    }
+  }
+  ASSERT_EQ(scores.size(), 3u);
+  EXPECT_EQ(scores[0].step, 499);
+  EXPECT_EQ(scores[1].step, 999);
+  EXPECT_EQ(scores[2].step, 1499);
+  EXPECT_FALSE(scores[0].final_score);
+  EXPECT_TRUE(scores[2].final_score);
+  for (const auto& m : scores) {
+    EXPECT_EQ(m.case_id, live.case_name);
+    EXPECT_GE(m.total, 0.0);
+    EXPECT_LE(m.total, 100.0);
+    ASSERT_EQ(m.n, static_cast<std::int16_t>(m.name.size()));
+    std::map<std::string, double> by_name;
+    for (int i = 0; i < m.n; ++i) by_name[m.name[static_cast<std::size_t>(i)]] = m.value[static_cast<std::size_t>(i)];
+    EXPECT_TRUE(by_name.count("efficiency") && by_name.count("tissue_treatment") && by_name.count("instrument_handling"));
+    for (const auto& [name, v] : by_name) {
+      EXPECT_GE(v, 0.0) << name;
+      EXPECT_LE(v, 100.0) << name;
+    }
+  }
+  // Time and path only add up: efficiency cannot rise while the session goes on.
+  auto efficiency = [](const vitreo_lcm::score_t& m) {
+    for (int i = 0; i < m.n; ++i)
+      if (m.name[static_cast<std::size_t>(i)] == "efficiency") return m.value[static_cast<std::size_t>(i)];
+    return -1.0;
+  };
+  EXPECT_LE(efficiency(scores[2]), efficiency(scores[0]));
+  // The summary prints the final score the channel carried, and the replay, which measures the
+  // same recorded session, prints the same lines.
+  ASSERT_FALSE(live.score_lines.empty());
+  char total[16];
+  std::snprintf(total, sizeof total, "%.0f / 100", scores[2].total);
+  EXPECT_EQ(live.score_lines[0].rfind(total, 0), 0u) << live.score_lines[0];
+  const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.state_hash, live.state_hash);
+  EXPECT_EQ(replay.score_lines, live.score_lines);
+  std::filesystem::remove(config.record_path);
+  std::filesystem::remove(log_path);
 }
 
 TEST(RigSession, ALostTrackerFreezesItsInstrumentAndTheSessionCarriesOn) {
