@@ -22,6 +22,7 @@
 #include "rig/session/case_switcher.hpp"
 #include "rig/session/frame_source.hpp"
 #include "rig/session/simulation_model.hpp"
+#include "fixed_poses.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/renderer.hpp"
 
@@ -38,18 +39,6 @@ vr::EglContext& context() {
   return ctx;
 }
 
-telemetry::DeviceInput tracker(int id, const core::Vec3& tip) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
-  in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
-  in.values[3] = 1.0;  // orientation: the shaft is rebuilt from the port through the tip
-  in.values[8] = 1.0;
-  in.values[9] = id;
-  in.values[10] = 3;
-  return in;
-}
-
 // The FrameScene of a case at the golden test's poses.
 vr::FrameScene case_scene(const std::string& name) {
   std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/" + name + ".toml")};
@@ -61,12 +50,7 @@ vr::FrameScene case_scene(const std::string& name) {
   mc.cases = cases;
   mc.load = load;
   rig::SimulationModel model(mc, loader.load_now(0));
-  const rig::PreparedCase& c = model.current_case();
-  const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
-  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
-  (void)model.apply(tracker(rig::kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized()));
-  (void)model.apply(tracker(rig::kToolTracker, tp + 5.0 * (c.focus_mm - tp).normalized()));
-  for (int i = 0; i < 3; ++i) model.step();
+  if (!rig::testing::place_at_fixed_poses(model)) throw std::runtime_error(name + ": poses refused");
   rig::ViewSnapshot view;
   if (!rig::capture_view(model, 3, 0.003, view)) throw std::runtime_error(name + ": no view captured");
   rig::FrameBuilder builder;

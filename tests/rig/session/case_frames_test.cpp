@@ -24,6 +24,7 @@
 #include "rig/session/case_switcher.hpp"
 #include "rig/session/frame_source.hpp"
 #include "rig/session/simulation_model.hpp"
+#include "fixed_poses.hpp"
 #include "synthetic_scene.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/image_compare.hpp"
@@ -66,19 +67,6 @@ Rgb patch(const vr::Image& img, vr::Vec2 p, int k) {
   }
   if (n > 0) s.r /= n, s.g /= n, s.b /= n;
   return s;
-}
-
-telemetry::DeviceInput tracker(int id, const core::Vec3& tip, double actuation) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
-  in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
-  in.values[3] = 1.0;  // orientation: the shaft is rebuilt from the port through the tip
-  in.values[7] = actuation;
-  in.values[8] = 1.0;
-  in.values[9] = id;
-  in.values[10] = 3;
-  return in;
 }
 
 class CaseFrames : public ::testing::TestWithParam<std::string> {
@@ -173,12 +161,8 @@ TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
   const rig::PreparedCase& c = model.current_case();
 
   // Fixed poses: the light pipe 6 mm into working_2 aimed at the case's region of interest, the
-  // first tool 5 mm into working_1 aimed at it too, jaws open.
-  const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
-  const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
-  ASSERT_TRUE(model.apply(tracker(rig::kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0)));
-  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 5.0 * (c.focus_mm - tp).normalized(), 0.0)));
-  for (int i = 0; i < 3; ++i) model.step();
+  // first tool 5 mm into working_1 aimed at it too, jaws open (fixed_poses.hpp).
+  ASSERT_TRUE(rig::testing::place_at_fixed_poses(model));
 
   rig::ViewSnapshot view;
   ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
@@ -341,8 +325,8 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   const core::Vec3 aim = model.scene().eye.wall_point(8.0 * std::numbers::pi / 180.0, std::numbers::pi);
   const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
-  ASSERT_TRUE(model.apply(tracker(rig::kLightPipeTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
-  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 8.0 * (aim - tp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kLightPipeTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kToolTracker, tp + 8.0 * (aim - tp).normalized(), 0.0)));
   telemetry::DeviceInput zoom;
   zoom.device_kind = rig::kCommandKind;
   zoom.n_values = 2;
@@ -405,7 +389,7 @@ TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
   const rig::PreparedCase& c = model.current_case();
   ASSERT_EQ(c.tools.at(0), core::InstrumentKind::kDrainageNeedle);
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
-  ASSERT_TRUE(model.apply(tracker(rig::kToolTracker, tp + 12.0 * (c.focus_mm - tp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kToolTracker, tp + 12.0 * (c.focus_mm - tp).normalized(), 0.0)));
   auto pedal = [](double vacuum, int switches) {
     telemetry::DeviceInput in;
     in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);

@@ -1,0 +1,28 @@
+#include "fixed_poses.hpp"
+
+namespace vitreo::rig::testing {
+
+telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation) {
+  telemetry::DeviceInput in;
+  in.device_kind = static_cast<std::int8_t>(InputKind::Tracker);
+  in.n_values = 11;
+  in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
+  in.values[3] = 1.0;  // orientation: the shaft is rebuilt from the port through the tip
+  in.values[7] = actuation;
+  in.values[8] = 1.0;
+  in.values[9] = id;
+  in.values[10] = 3;
+  return in;
+}
+
+bool place_at_fixed_poses(SimulationModel& model) {
+  const PreparedCase& c = model.current_case();
+  const core::Vec3 lp = c.tracker_ports[kLightPipeTracker].position_mm;
+  const core::Vec3 tp = c.tracker_ports[kToolTracker].position_mm;
+  if (!model.apply(tracker_sample(kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0))) return false;
+  if (!model.apply(tracker_sample(kToolTracker, tp + 5.0 * (c.focus_mm - tp).normalized(), 0.0))) return false;
+  for (int i = 0; i < 3; ++i) model.step();
+  return true;
+}
+
+}  // namespace vitreo::rig::testing
