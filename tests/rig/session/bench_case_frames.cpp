@@ -41,15 +41,10 @@ vr::EglContext& context() {
 
 // The FrameScene of a case at the golden test's poses.
 vr::FrameScene case_scene(const std::string& name) {
-  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/" + name + ".toml")};
-  scene_io::CaseLoadOptions load;
-  load.retina_vertices = 5000;  // the main job's default
-  load.cache_dir = (std::filesystem::temp_directory_path() / "vitreo-bench-case-cache").string();
-  rig::CaseSwitcher loader(cases, load, /*visuals=*/true);
-  rig::ModelConfig mc;
-  mc.cases = cases;
-  mc.load = load;
-  rig::SimulationModel model(mc, loader.load_now(0));
+  // The main job's default resolution.
+  rig::testing::CaseUnderTest under_test(kScenes + "/" + name + ".toml", 5000,
+                                         (std::filesystem::temp_directory_path() / "vitreo-bench-case-cache").string());
+  rig::SimulationModel& model = under_test.model;
   if (!rig::testing::place_at_fixed_poses(model)) throw std::runtime_error(name + ": poses refused");
   rig::ViewSnapshot view;
   if (!rig::capture_view(model, 3, 0.003, view)) throw std::runtime_error(name + ": no view captured");

@@ -148,16 +148,8 @@ void expect_golden(const vr::Image& full, const std::string& name) {
 
 TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
   const std::string name = GetParam();
-  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/" + name + ".toml")};
-  scene_io::CaseLoadOptions load;
-  load.retina_vertices = 2000;
-  load.texture_size_px = 0;  // the case's own (1024 px): peripheral vessels vanish below that
-  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
-  rig::CaseSwitcher loader(cases, load, /*visuals=*/true);  // owns the case's look for the test
-  rig::ModelConfig mc;
-  mc.cases = cases;
-  mc.load = load;
-  rig::SimulationModel model(mc, loader.load_now(0));
+  rig::testing::CaseUnderTest under_test(kScenes + "/" + name + ".toml", 2000, VITREO_CASE_CACHE_DIR);
+  rig::SimulationModel& model = under_test.model;
   const rig::PreparedCase& c = model.current_case();
 
   // Fixed poses: the light pipe 6 mm into working_2 aimed at the case's region of interest, the
@@ -258,16 +250,8 @@ INSTANTIATE_TEST_SUITE_P(EveryCase, CaseFrames, ::testing::ValuesIn(case_names()
 // The operator's view toggles reach the picture: wireframe draws the tissue's edges, zoom narrows
 // the field (the optic disc moves away from the image centre by the zoom factor).
 TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
-  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_pull_tissue.toml")};
-  scene_io::CaseLoadOptions load;
-  load.retina_vertices = 2000;
-  load.texture_size_px = 0;  // the case's own (1024 px): peripheral vessels vanish below that
-  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
-  rig::CaseSwitcher loader(cases, load, true);
-  rig::ModelConfig mc;
-  mc.cases = cases;
-  mc.load = load;
-  rig::SimulationModel model(mc, loader.load_now(0));
+  rig::testing::CaseUnderTest under_test(kScenes + "/exercise_pull_tissue.toml", 2000, VITREO_CASE_CACHE_DIR);
+  rig::SimulationModel& model = under_test.model;
   model.step();
   rig::FrameBuilder builder;
   auto frame_of = [&] {
@@ -308,15 +292,8 @@ TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
 // through the pedal's laser switch; the burn the instrument system records reaches the frame at
 // that spot and shows whitish there, against the same frame without it.
 TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
-  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_laser_tear.toml")};
-  scene_io::CaseLoadOptions load;
-  load.retina_vertices = 2000;
-  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
-  rig::CaseSwitcher loader(cases, load, true);
-  rig::ModelConfig mc;
-  mc.cases = cases;
-  mc.load = load;
-  rig::SimulationModel model(mc, loader.load_now(0));
+  rig::testing::CaseUnderTest under_test(kScenes + "/exercise_laser_tear.toml", 2000, VITREO_CASE_CACHE_DIR);
+  rig::SimulationModel& model = under_test.model;
   const rig::PreparedCase& c = model.current_case();
   ASSERT_FALSE(c.tools.empty());
   ASSERT_EQ(c.tools[0], core::InstrumentKind::kEndolaser);
@@ -377,15 +354,8 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
 // (whose own test, RenderScenes.FluidGasInterfaceIsVisible, shows the interface at the wall; from
 // this view, behind the lens, the meniscus lies outside the field).
 TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
-  std::vector<scene_io::CaseText> cases{scene_io::read_case_text(kScenes + "/exercise_drain_tear.toml")};
-  scene_io::CaseLoadOptions load;
-  load.retina_vertices = 2000;
-  load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
-  rig::CaseSwitcher loader(cases, load, true);
-  rig::ModelConfig mc;
-  mc.cases = cases;
-  mc.load = load;
-  rig::SimulationModel model(mc, loader.load_now(0));
+  rig::testing::CaseUnderTest under_test(kScenes + "/exercise_drain_tear.toml", 2000, VITREO_CASE_CACHE_DIR);
+  rig::SimulationModel& model = under_test.model;
   const rig::PreparedCase& c = model.current_case();
   ASSERT_EQ(c.tools.at(0), core::InstrumentKind::kDrainageNeedle);
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;

@@ -2,6 +2,25 @@
 
 namespace vitreo::rig::testing {
 
+namespace {
+scene_io::CaseLoadOptions load_options(int retina_vertices, const std::string& cache_dir) {
+  scene_io::CaseLoadOptions o;
+  o.retina_vertices = retina_vertices;
+  o.cache_dir = cache_dir;
+  return o;  // the case's own texture size: peripheral vessels vanish below 1024 px
+}
+ModelConfig model_config(const std::vector<scene_io::CaseText>& cases, const scene_io::CaseLoadOptions& load) {
+  ModelConfig m;
+  m.cases = cases;
+  m.load = load;
+  return m;
+}
+}  // namespace
+
+CaseUnderTest::CaseUnderTest(const std::string& scene_file, int retina_vertices, const std::string& cache_dir)
+    : loader({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir), /*visuals=*/true),
+      model(model_config({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir)), loader.load_now(0)) {}
+
 telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation) {
   telemetry::DeviceInput in;
   in.device_kind = static_cast<std::int8_t>(InputKind::Tracker);

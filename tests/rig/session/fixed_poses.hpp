@@ -3,10 +3,22 @@
 // samples as the tracker driver delivers them, and the standard framing of a case — the light pipe
 // 6 mm into its port and the first tool 5 mm into its own, both aimed at the case's region of
 // interest, jaws open, settled for three steps.
+#include <memory>
+#include <string>
+
 #include "core/common/types.hpp"
+#include "rig/session/case_switcher.hpp"
 #include "rig/session/simulation_model.hpp"
 
 namespace vitreo::rig::testing {
+
+// One case from scenes/ loaded the way a session loads it, with its look (visuals) for rendering;
+// the loader owns the case's static meshes and textures, so it lives as long as the model.
+struct CaseUnderTest {
+  CaseUnderTest(const std::string& scene_file, int retina_vertices, const std::string& cache_dir);
+  CaseSwitcher loader;
+  SimulationModel model;
+};
 
 // A tracker sample for instrument `id` with its tip at `tip` (eye-fixture frame); the orientation
 // is left to the port (the shaft is rebuilt from the port through the tip).
