@@ -581,35 +581,35 @@ std::uint32_t Surface::separate_fans(std::uint32_t v, std::vector<std::uint32_t>
     }
   });
   if (n < 2 || overflow) return 0;
-  group.fill(0);
-  std::uint8_t groups = 0;
-  for (std::size_t s = 0; s < n; ++s) {
-    if (group[s]) continue;
-    ++groups;
-    group[s] = groups;
-    // Flood fill over triangles sharing an edge through v.
-    bool grew = true;
-    while (grew) {
-      grew = false;
-      for (std::size_t i = 0; i < n; ++i) {
-        if (group[i] != groups) continue;
-        for (std::size_t j = 0; j < n; ++j) {
-          if (group[j]) continue;
-          // Triangles i and j are connected at v when they share an edge incident to v.
-          for (std::uint32_t k = 0; k < 3 && !group[j]; ++k) {
-            const std::uint32_t ei = tri_e_[tris[i]][k];
-            if (ei == kNone || (edge_v_[ei][0] != v && edge_v_[ei][1] != v)) continue;
-            for (std::uint32_t l = 0; l < 3; ++l) {
-              if (tri_e_[tris[j]][l] == ei) {
-                group[j] = groups;
-                grew = true;
-                break;
-              }
-            }
-          }
-        }
+  // Triangles joined through a spring at v belong to one fan: join each triangle to the other
+  // triangle of its two springs through v (edge_t_ knows it), with a small union–find over the
+  // fan's positions. Fans are numbered by their first triangle in the corner list, so the fan of
+  // the first triangle keeps v and the others get copies in a fixed order.
+  std::array<std::uint8_t, 64> parent{};
+  for (std::size_t i = 0; i < n; ++i) parent[i] = static_cast<std::uint8_t>(i);
+  auto root = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const std::uint32_t e : tri_e_[tris[i]]) {
+      if (e == kNone || (edge_v_[e][0] != v && edge_v_[e][1] != v)) continue;
+      const std::uint32_t other = edge_t_[e][0] == tris[i] ? edge_t_[e][1] : edge_t_[e][0];
+      if (other == kNone) continue;
+      for (std::size_t j = 0; j < n; ++j) {
+        if (tris[j] != other) continue;
+        const std::size_t ri = root(i), rj = root(j);
+        if (ri != rj) parent[std::max(ri, rj)] = static_cast<std::uint8_t>(std::min(ri, rj));
+        break;
       }
     }
+  }
+  group.fill(0);
+  std::uint8_t groups = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t r = root(i);
+    if (r == i) group[i] = ++groups;  // the smallest position of a fan is its root: seen first
+    else group[i] = group[r];
   }
   if (groups < 2) return 0;
   std::uint32_t copies = 0;

@@ -2,6 +2,7 @@
 // separate fans, remove a triangle. core/topology composes cuts, tears and vitrector removal from
 // these; each keeps the invariants listed in core/README.md on its own.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/tissue/surface.hpp"
@@ -16,15 +17,42 @@ bool Surface::has_room(std::uint32_t vertices, std::uint32_t edges, std::uint32_
 }
 
 void Surface::refresh_around(std::uint32_t v) {
-  update_vertex_mass(v);
-  wake_vertex(v);
+  // Each vertex and spring of v's triangles once (a fan repeats v and shares springs): the masses
+  // and stiffnesses only depend on the current rest areas, so updating each once is enough.
+  std::array<std::uint32_t, 48> verts{}, edges{};
+  std::size_t nv = 0, ne = 0;
+  auto add_once = [](std::array<std::uint32_t, 48>& list, std::size_t& n, std::uint32_t x) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (list[i] == x) return true;
+    }
+    if (n == list.size()) return false;
+    list[n++] = x;
+    return true;
+  };
+  bool fits = add_once(verts, nv, v);
   for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
     for (std::uint32_t k = 0; k < 3; ++k) {
-      update_edge_stiffness(tri_e_[t][k]);
-      update_vertex_mass(tri_v_[t][k]);
-      wake_vertex(tri_v_[t][k]);
+      fits = add_once(verts, nv, tri_v_[t][k]) && fits;
+      fits = add_once(edges, ne, tri_e_[t][k]) && fits;
     }
   });
+  if (!fits) {  // a fan too large for the lists: every vertex and spring, repeats and all
+    update_vertex_mass(v);
+    wake_vertex(v);
+    for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        update_edge_stiffness(tri_e_[t][k]);
+        update_vertex_mass(tri_v_[t][k]);
+        wake_vertex(tri_v_[t][k]);
+      }
+    });
+    return;
+  }
+  for (std::size_t i = 0; i < ne; ++i) update_edge_stiffness(edges[i]);
+  for (std::size_t i = 0; i < nv; ++i) {
+    update_vertex_mass(verts[i]);
+    wake_vertex(verts[i]);
+  }
 }
 
 void Surface::free_vertex(std::uint32_t v) {

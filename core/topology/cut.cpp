@@ -42,8 +42,15 @@ Cutter::Cutter(Surface& surface, CutSettings settings)
   for (std::uint32_t e = 0; e < surface.edge_slots(); ++e) {
     if (surface.edge_alive(e)) longest = std::max(longest, surface.edge_rest_length(e));
   }
-  // A spring may be stretched up to its tear strain; twice its rest length covers every material's.
-  margin_mm_ = 2.0 * longest + settings_.band_mm;
+  // How far from the swept quad a vertex can matter, for springs no longer than L (a spring may be
+  // stretched up to its tear strain; L = twice the longest rest length covers every material's):
+  //  - a spring crossing the quad at y has |a − y| + |y − b| = L, so one end lies within L/2;
+  //  - a point inside a triangle lies within L/√3 of its nearest corner (the worst point is the
+  //    centre of an equilateral triangle), so a triangle the quad's rim passes through, or a quad
+  //    corner rests on, has a corner within L/√3 (+ the band) of the rim.
+  // L/√3 + band covers both: vertices beyond it are never candidates (half the old 2L margin's
+  // strip, hence half the vertices, triangles and springs each stroke visits).
+  margin_mm_ = 2.0 * longest / std::sqrt(3.0) + settings_.band_mm;
 }
 
 bool Cutter::near_swept(const Vec3& p, double tolerance) const {
@@ -66,7 +73,7 @@ void Cutter::mark(std::uint32_t v) {
 void Cutter::gather_candidates() {
   candidates_.clear();
   const Surface& s = surface_;
-  index_.for_each_in_box(box_lo_, box_hi_, [&](std::uint32_t v) {
+  const auto wanted = [&](std::uint32_t v) {
     const Vec3& x = s.position(v);
     if (!near_swept(x, margin_mm_)) return;
     candidates_.push_back(v);
@@ -78,7 +85,21 @@ void Cutter::gather_candidates() {
       near_rim_[v] = stamp_;
       rim_mask_[v] = mask;
     }
-  });
+  };
+  // A block can hold a candidate only if its box comes within the margin of the plane of one of
+  // the swept triangles (a point near a triangle is near its plane): the box's extent along the
+  // normal is its centre's distance ± the half-sizes projected on |n|.
+  const auto block_near_quad = [&](const Vec3& lo, const Vec3& hi) {
+    const Vec3 centre = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (!swept_valid_[k]) continue;
+      const Vec3& n = swept_normal_[k];
+      const double reach = n.cwiseAbs().dot(half) + margin_mm_;
+      if (std::abs(n.dot(centre - swept_[k][0])) <= reach) return true;
+    }
+    return false;
+  };
+  index_.for_each_in_box(box_lo_, box_hi_, wanted, block_near_quad);
 }
 
 // Triangles and springs around the candidate vertices (deduplicated, in a fixed order).
@@ -160,14 +181,12 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   auto rim_bits = [&](std::uint32_t v) { return near_rim_[v] == stamp_ ? rim_mask_[v] : std::uint8_t{0}; };
   for (auto t : triangles_) {
     const auto tv = s.triangle_vertices(t);
-    // Only triangles near the quad's boundary can hold an end; a rim segment can pass through a
-    // triangle only if all three corners lie within the margin of it (a corner is never farther
-    // from a point of its triangle than the triangle's longest edge).
+    // Only triangles near the quad's boundary can hold an end: a rim segment passing through a
+    // triangle passes within the margin of one of its corners (see the constructor).
     const std::uint8_t any = rim_bits(tv[0]) | rim_bits(tv[1]) | rim_bits(tv[2]);
     if (any == 0) continue;
-    const std::uint8_t all = rim_bits(tv[0]) & rim_bits(tv[1]) & rim_bits(tv[2]);
     for (std::size_t k = 0; k < boundary.size(); ++k) {
-      if (!(all & (1u << k))) continue;
+      if (!(any & (1u << k))) continue;
       const auto& seg = boundary[k];
       if ((seg[1] - seg[0]).squaredNorm() < 1e-24) continue;
       double sp;
@@ -177,8 +196,12 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     }
     // A corner of the quad resting on the triangle (within the band) ends the cut there too.
     for (const Vec3& c : {p0, q0, p1, q1}) {
-      // Cheap rejection: a corner on the triangle lies within a spring's length of its corners.
-      if ((c - s.position(tv[0])).squaredNorm() > margin_mm_ * margin_mm_) continue;
+      // Cheap rejection: a corner on the triangle lies within the margin of its nearest corner.
+      const double m2 = margin_mm_ * margin_mm_;
+      if ((c - s.position(tv[0])).squaredNorm() > m2 && (c - s.position(tv[1])).squaredNorm() > m2 &&
+          (c - s.position(tv[2])).squaredNorm() > m2) {
+        continue;
+      }
       const Vec3 y = closest_point_on_triangle(c, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]));
       if ((y - c).norm() <= band) add_end(y, t);
     }

@@ -6,11 +6,11 @@
 namespace vitreo::core {
 
 VertexIndex::VertexIndex(const Surface& surface) : surface_(surface) {
-  const std::size_t blocks = surface.block_count();
-  box_lo_.assign(blocks, Vec3::Zero());
-  box_hi_.assign(blocks, Vec3::Zero());
-  seen_motion_.assign(blocks, 0);
-  fitted_.assign(blocks, 0);
+  const std::size_t patches = static_cast<std::size_t>(surface.block_count()) * (Surface::kSleepBlock / kPatch);
+  box_lo_.assign(patches, Vec3::Zero());
+  box_hi_.assign(patches, Vec3::Zero());
+  seen_motion_.assign(patches, 0);
+  fitted_.assign(patches, 0);
 }
 
 void VertexIndex::refresh() {
@@ -18,20 +18,21 @@ void VertexIndex::refresh() {
   const std::uint32_t n = s.vertex_slots();
   last_refits_ = 0;
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  for (std::uint32_t b = 0; b < blocks_in_use(); ++b) {
-    if (fitted_[b] && seen_motion_[b] == s.block_motion(b)) continue;
-    // An empty block gets an inverted box, which no query overlaps.
+  for (std::uint32_t p = 0; p < patches_in_use(); ++p) {
+    const std::uint32_t motion = s.block_motion(p * kPatch / Surface::kSleepBlock);
+    if (fitted_[p] && seen_motion_[p] == motion) continue;
+    // An empty patch gets an inverted box, which no query overlaps.
     Vec3 lo = Vec3::Constant(kInf), hi = Vec3::Constant(-kInf);
-    const std::uint32_t end = std::min(n, (b + 1) * Surface::kSleepBlock);
-    for (std::uint32_t v = b * Surface::kSleepBlock; v < end; ++v) {
+    const std::uint32_t end = std::min(n, (p + 1) * kPatch);
+    for (std::uint32_t v = p * kPatch; v < end; ++v) {
       if (!s.vertex_alive(v)) continue;
       lo = lo.cwiseMin(s.position(v));
       hi = hi.cwiseMax(s.position(v));
     }
-    box_lo_[b] = lo;
-    box_hi_[b] = hi;
-    seen_motion_[b] = s.block_motion(b);
-    fitted_[b] = 1;
+    box_lo_[p] = lo;
+    box_hi_[p] = hi;
+    seen_motion_[p] = motion;
+    fitted_[p] = 1;
     ++last_refits_;
   }
 }
