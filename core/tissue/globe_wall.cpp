@@ -60,13 +60,6 @@ GlobeWall GlobeWall::from_profile(const Vec3& center, const std::vector<ProfileP
   return w;
 }
 
-double GlobeWall::radius_at_cos(double c) const {
-  const double s = (std::clamp(c, -1.0, 1.0) + 1.0) * 0.5 * (kTableSize - 1);
-  const int i = std::min(static_cast<int>(s), kTableSize - 2);
-  const double f = s - i;
-  return radius_by_cos_[static_cast<std::size_t>(i)] * (1.0 - f) + radius_by_cos_[static_cast<std::size_t>(i) + 1] * f;
-}
-
 double GlobeWall::radius_toward(const Vec3& d) const {
   return radius_toward(d, d.norm());
 }

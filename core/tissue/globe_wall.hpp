@@ -6,6 +6,7 @@
 // globe is star-shaped about its centre, so the wall is a radius R(θ) for each polar angle θ from the
 // +z (anterior) axis, tabulated finely from the anatomical profile and interpolated in cos θ, which
 // costs a square root and a table lookup per vertex.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -48,7 +49,14 @@ class GlobeWall {
 
  private:
   static constexpr int kTableSize = 2049;
-  double radius_at_cos(double c) const;
+  // Inline: called per vertex and substep (the wall's contact and projection), where a call costs
+  // as much as the lookup.
+  double radius_at_cos(double c) const {
+    const double s = (std::clamp(c, -1.0, 1.0) + 1.0) * 0.5 * (kTableSize - 1);
+    const int i = std::min(static_cast<int>(s), kTableSize - 2);
+    const double f = s - i;
+    return radius_by_cos_[static_cast<std::size_t>(i)] * (1.0 - f) + radius_by_cos_[static_cast<std::size_t>(i) + 1] * f;
+  }
 
   Vec3 center_ = Vec3::Zero();
   std::vector<double> radius_by_cos_;  // index i ↔ cos θ = -1 + 2i/(kTableSize-1)

@@ -439,10 +439,6 @@ std::uint32_t Surface::awake_block_count() const {
   return static_cast<std::uint32_t>(std::count(block_awake_.begin(), block_awake_.end(), std::uint8_t{1}));
 }
 
-Surface::SolverView Surface::solver_view() {
-  return SolverView{x_, v_, inverse_mass_, vertex_alive_, edge_v_, rest_vec_, rest_len_, stiffness_, edge_alive_,
-                    tri_v_, tri_alive_, vertex_area_};
-}
 
 // ---- Tearing ----------------------------------------------------------------------------------
 

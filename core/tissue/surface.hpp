@@ -342,4 +342,10 @@ struct Surface::SolverView {
   std::span<const double> vertex_area;  // lumped rest area per vertex (for drag and local forces)
 };
 
+// Inline: the solver takes views in its per-attachment and per-stage loops.
+inline Surface::SolverView Surface::solver_view() {
+  return SolverView{x_, v_, inverse_mass_, vertex_alive_, edge_v_, rest_vec_, rest_len_, stiffness_, edge_alive_,
+                    tri_v_, tri_alive_, vertex_area_};
+}
+
 }  // namespace vitreo::core
