@@ -8,6 +8,7 @@
 
 #include "core/common/validate.hpp"
 #include "core/geometry/revolved_mesh.hpp"
+#include "core/topology/clean_topology.hpp"
 
 namespace vitreo::core {
 
@@ -130,6 +131,8 @@ RetinaCapScene build_retina_cap(const RetinaCapOptions& o) {
       ++scene.attachments;
     }
   }
+  // The solver's tears and creep clean up after themselves like the tools' cuts (clean_topology.hpp).
+  install_clean_topology(world);
   return scene;
 }
 

@@ -8,6 +8,7 @@
 
 #include "core/common/validate.hpp"
 #include "core/scene/world_access.hpp"
+#include "core/topology/clean_topology.hpp"
 
 namespace vitreo::core {
 
@@ -594,6 +595,8 @@ Scene build_scene(const SceneDescription& description, const BuildOptions& optio
   if (options.textures) {
     scene.textures = generate_fundus(e, {description.texture_seed, description.texture_size_px});
   }
+  // The solver's tears and creep clean up after themselves like the tools' cuts (clean_topology.hpp).
+  install_clean_topology(w);
   if (options.settle) scene.settle = settle_world(w, description.settle);
   return scene;
 }

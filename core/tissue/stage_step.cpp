@@ -11,7 +11,8 @@ namespace vitreo::core {
 
 namespace {
 constexpr double kMaxDt_s = 0.02;
-// The smallest spring a tear may split (10 µm, the topology engine's floor on piece size).
+// Without a topology hook: the smallest spring a tear may split (10 µm, the topology engine's
+// floor on piece size).
 constexpr double kMinTearRest_mm = 0.01;
 }
 
@@ -190,15 +191,16 @@ void TissueWorld::find_overstrained() {
     if (!std::isfinite(tear)) continue;
     auto view = s.solver_view();
     const double f2 = (1.0 + tear) * (1.0 + tear);
+    // Springs too short to split are not torn again: repeated tears at one spot would otherwise
+    // halve them towards zero length (and zero-area triangles).
+    const double min_rest = hooks_[si] ? hooks_[si]->min_tear_rest_mm() : kMinTearRest_mm;
     for_each_active_edge(si, [&](std::uint32_t e) {
       const auto [a, b] = view.edge_v[e];
       const double len2 = (view.x[b] - view.x[a]).squaredNorm();
       const double limit2 = f2 * view.rest_len[e] * view.rest_len[e];
-      // Springs already shorter than kMinTearRest_mm are not split again: repeated tears at one
-      // spot would otherwise halve them towards zero length (and zero-area triangles).
-      if (view.rest_len[e] < kMinTearRest_mm) return;
+      if (view.rest_len[e] < min_rest) return;
       if (len2 > limit2 && tear_candidates_.size() < tear_candidates_.capacity()) {
-        tear_candidates_.push_back({si, e, std::sqrt(len2) / view.rest_len[e] - 1.0});
+        tear_candidates_.push_back({si, s.edge_id(e), std::sqrt(len2) / view.rest_len[e] - 1.0});
       }
     });
   }
@@ -213,24 +215,44 @@ void TissueWorld::tear_overstrained() {
   std::sort(tear_candidates_.begin(), tear_candidates_.end(), [](const TearCandidate& l, const TearCandidate& r) {
     if (l.strain != r.strain) return l.strain > r.strain;
     if (l.surface != r.surface) return l.surface < r.surface;
-    return l.edge < r.edge;
+    return l.edge.index < r.edge.index;
   });
   int torn = 0;
   for (const auto& c : tear_candidates_) {
     if (torn >= settings_.max_tears_per_step) break;
     Surface& s = *surfaces_[c.surface];
-    if (!s.edge_alive(c.edge)) continue;
-    // Re-check: an earlier tear this step may have relieved it or replaced it.
-    const double strain = s.edge_strain(c.edge);
+    // An earlier tear this step may have split it (its handle is then stale) or relieved it.
+    if (!s.is_current(c.edge)) continue;
+    const double strain = s.edge_strain(c.edge.index);
     if (!(strain > s.material().tear_strain)) continue;
-    const auto ev = s.edge_vertices(c.edge);
+    const auto ev = s.edge_vertices(c.edge.index);
     const Vec3 where = 0.5 * (s.position(ev[0]) + s.position(ev[1]));
-    const auto result = s.tear_edge(s.edge_id(c.edge));
-    if (!result.status) continue;  // pool full: the spring stays, the next step tries again
+    TopologyHook* hook = hooks_[c.surface].get();
+    Status status = Status::ok();
+    if (hook) {
+      const TopologyHookResult r = hook->tear(c.edge);
+      status = r.status;
+      cleanup_removed_mass_g_ += r.removed_mass_g;
+    } else {
+      status = s.tear_edge(c.edge).status;
+    }
+    if (!status) continue;  // pool full: the spring stays, the next step tries again
     ++torn;
     if (events_.size() < events_.capacity()) {
-      events_.push_back({TissueEventKind::kTear, c.surface, c.edge, where, strain});
+      events_.push_back({TissueEventKind::kTear, c.surface, c.edge.index, where, strain});
     }
+  }
+}
+
+// Plastic creep, and the topology hook's cleanup where it shrank springs below the quality floor
+// (creep is the one change of rest shape that happens inside the step, not through an operation
+// that cleans up after itself).
+void TissueWorld::creep_and_tidy(double dt_s) {
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
+    TopologyHook* hook = hooks_[si].get();
+    crept_short_.clear();
+    surfaces_[si]->apply_plasticity(dt_s, hook ? hook->min_rest_mm() : 0.0, hook ? &crept_short_ : nullptr);
+    if (hook && !crept_short_.empty()) cleanup_removed_mass_g_ += hook->clean_around(crept_short_).removed_mass_g;
   }
 }
 
@@ -292,7 +314,7 @@ StepReport TissueWorld::step(double dt_s) {
     return report;
   }
 
-  for (auto& sp : surfaces_) sp->apply_plasticity(dt_s);
+  creep_and_tidy(dt_s);
   break_attachments();
   break_grips();
   tear_overstrained();

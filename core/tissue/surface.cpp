@@ -386,7 +386,7 @@ Status Surface::set_edge_traction(EdgeId id, double scale) {
   return Status::ok();
 }
 
-void Surface::apply_plasticity(double dt_s) {
+void Surface::apply_plasticity(double dt_s, double floor_mm, std::vector<std::uint32_t>* crept_short) {
   const double rate = material_.plastic_rate_per_s;
   if (!(rate > 0.0)) return;
   const double yield = material_.plastic_yield_strain;
@@ -403,7 +403,12 @@ void Surface::apply_plasticity(double dt_s) {
     // Creep only by the part beyond the yield, so small elastic deformations still spring back.
     const Vec3 excess = diff * (1.0 - yield * base_len / diff.norm());
     base_rest_vec_[e] += alpha * excess;
+    const double before = rest_len_[e];
     refresh_rest(e);
+    if (crept_short && before >= floor_mm && rest_len_[e] < floor_mm && crept_short->size() + 2 <= crept_short->capacity()) {
+      crept_short->push_back(a);
+      crept_short->push_back(b);
+    }
   }
 }
 

@@ -262,8 +262,10 @@ class Surface {
   SolverView solver_view();
 
   // Plastic flow: rest vectors creep toward the current edge vectors where the strain exceeds the
-  // material's yield. Called by the solver once per step.
-  void apply_plasticity(double dt_s);
+  // material's yield. Called by the solver once per step. With `crept_short`, the two ends of each
+  // spring whose rest length crept from at least `floor_mm` to below it this step are appended
+  // (while the list has capacity: nothing allocates), so the topology layer can tidy there.
+  void apply_plasticity(double dt_s, double floor_mm = 0.0, std::vector<std::uint32_t>* crept_short = nullptr);
 
   // Recomputes mass and inverse mass of vertex v from its adjacent rest area.
   void update_vertex_mass(std::uint32_t v);

@@ -41,6 +41,7 @@ TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings
   settings_.validate();
   events_.reserve(256);
   tear_candidates_.reserve(4096);
+  crept_short_.reserve(4096);
   colliders_.resize(kMaxColliders);
   candidates_.reserve(kMaxContactCandidates);
   suction_.reserve(kMaxSuctionFields);
@@ -81,9 +82,15 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.lambda_distance.resize(surface->edge_capacity());
   s.lambda_direction.resize(surface->edge_capacity());
   surfaces_.push_back(std::move(surface));
+  hooks_.push_back(nullptr);
   scratch_.push_back(std::move(s));
   contact_force_.assign(std::size_t{kMaxColliders} * surfaces_.size(), Vec3::Zero());
   return static_cast<std::uint32_t>(surfaces_.size() - 1);
+}
+
+void TissueWorld::set_topology_hook(std::uint32_t surface, std::unique_ptr<TopologyHook> hook) {
+  if (surface >= surfaces_.size()) throw InvalidArgument("topology hook: surface out of range");
+  hooks_[surface] = std::move(hook);
 }
 
 std::uint32_t TissueWorld::add_attachment(const AttachmentDescription& d) {

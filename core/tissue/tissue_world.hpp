@@ -24,6 +24,7 @@
 #include "core/common/units.hpp"
 #include "core/tissue/globe_wall.hpp"
 #include "core/tissue/surface.hpp"
+#include "core/tissue/topology_hook.hpp"
 
 namespace vitreo::core {
 
@@ -164,6 +165,12 @@ class TissueWorld {
   std::uint32_t add_attachment(const AttachmentDescription& description);
   std::uint32_t add_local_force(const LocalForceDescription& description);
 
+  // How a surface's overstrained springs are torn and its crept springs tidied (topology_hook.hpp;
+  // core/topology's install_clean_topology sets it on every surface). Null: Surface::tear_edge, no
+  // tidying. Throws InvalidArgument for a surface out of range.
+  void set_topology_hook(std::uint32_t surface, std::unique_ptr<TopologyHook> hook);
+  TopologyHook* topology_hook(std::uint32_t surface) const { return hooks_.at(surface).get(); }
+
   // ---- Run-time controls (never throw) --------------------------------------------------------
   Status set_environment(const Environment& environment);
   Status set_local_force_scale(std::uint32_t force, double scale);
@@ -223,6 +230,9 @@ class TissueWorld {
   double time_s() const { return time_s_; }
 
   double total_mass() const;
+  // Mass the topology hooks' cleanup removed as lone sliver fragments after the solver's tears and
+  // creep (g, since the world was built): total_mass() = initial − this − what tools removed.
+  double cleanup_removed_mass_g() const { return cleanup_removed_mass_g_; }
   Energy energy() const;
   std::uint64_t state_hash() const;
 
@@ -311,7 +321,7 @@ class TissueWorld {
   };
   struct TearCandidate {
     std::uint32_t surface;
-    std::uint32_t edge;
+    EdgeId edge;
     double strain;
   };
 
@@ -333,6 +343,7 @@ class TissueWorld {
   void break_attachments();
   void find_overstrained();
   void tear_overstrained();
+  void creep_and_tidy(double dt_s);
   void prepare_sleep_groups();
   void finish_sleep();
   template <class F>
@@ -344,7 +355,10 @@ class TissueWorld {
   Environment environment_;
   SolverSettings settings_;
   std::vector<std::unique_ptr<Surface>> surfaces_;
+  std::vector<std::unique_ptr<TopologyHook>> hooks_;  // per surface, may be null
   std::vector<Scratch> scratch_;
+  std::vector<std::uint32_t> crept_short_;  // vertices of springs that crept below the floor this step
+  double cleanup_removed_mass_g_ = 0.0;
   std::vector<Attachment> attachments_;
   std::vector<LocalForce> local_forces_;
   std::vector<TissueEvent> events_;

@@ -70,21 +70,33 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
     if (spokes[i] == ends[0] || spokes[i] == ends[1]) continue;
     if (ncrack < 2) crack[static_cast<std::size_t>(ncrack++)] = s.edge_id(spokes[i]);
   }
-  // Run the crack part of the way toward each opposite vertex: split the spoke there.
+  // Run the crack part of the way toward each opposite vertex: split the spoke there. A spoke too
+  // short to hold a tip (a small triangle's) is opened whole: the crack reaches the opposite vertex
+  // on that side. Either way the tear opens, so a spring torn once is never torn "again" in place.
   std::array<EdgeId, 2> open{};
+  std::array<std::uint32_t, 2> reached{kNone, kNone};  // opposite vertices the crack runs into
   int nopen = 0;
   for (int i = 0; i < ncrack; ++i) {
     const EdgeId c = crack[static_cast<std::size_t>(i)];
     const auto ev = s.edge_vertices(c.index);
-    // A spoke too short to split (a sliver's): the crack stops at the split point on that side.
-    if (s.edge_rest_length(c.index) < 2.0 * settings.min_spring_length_mm) continue;
-    const double t = ev[0] == m ? settings.crack_fraction : 1.0 - settings.crack_fraction;
-    const auto tip = s.split_edge(c, t);
-    if (!tip.status) continue;
-    ++r.vertices_added;
-    touched[static_cast<std::size_t>(3 + i)] = tip.vertex;
-    const std::uint32_t e = s.find_edge(m, tip.vertex);
-    if (e != kNone) open[static_cast<std::size_t>(nopen++)] = s.edge_id(e);
+    const std::uint32_t opposite = ev[0] == m ? ev[1] : ev[0];
+    bool tipped = false;
+    if (s.edge_rest_length(c.index) >= 2.0 * settings.min_spring_length_mm) {
+      const double t = ev[0] == m ? settings.crack_fraction : 1.0 - settings.crack_fraction;
+      const auto tip = s.split_edge(c, t);
+      if (tip.status) {
+        tipped = true;
+        ++r.vertices_added;
+        touched[static_cast<std::size_t>(3 + i)] = tip.vertex;
+        const std::uint32_t e = s.find_edge(m, tip.vertex);
+        if (e != kNone) open[static_cast<std::size_t>(nopen++)] = s.edge_id(e);
+      }
+    }
+    if (!tipped) {
+      open[static_cast<std::size_t>(nopen++)] = c;
+      reached[static_cast<std::size_t>(i)] = opposite;
+      touched[static_cast<std::size_t>(3 + i)] = opposite;
+    }
   }
   for (int i = 0; i < nopen; ++i) {
     const EdgeId e = open[static_cast<std::size_t>(i)];
@@ -92,6 +104,9 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
   }
   if (quality == nullptr) {
     r.vertices_added += s.separate_vertex_fans(s.vertex_id(m));
+    for (auto o : reached) {
+      if (o != kNone) r.vertices_added += s.separate_vertex_fans(s.vertex_id(o));  // a bow-tie at a boundary
+    }
   } else {
     auto& seeds = quality->seeds();
     seeds.clear();
@@ -99,6 +114,9 @@ SpringTearResult tear_spring(Surface& s, EdgeId id, const TearSettings& settings
       if (v != kNone) seeds.push_back(v);
     }
     r.vertices_added += s.separate_vertex_fans(s.vertex_id(m), &seeds);  // m's copies too
+    for (auto o : reached) {
+      if (o != kNone) r.vertices_added += s.separate_vertex_fans(s.vertex_id(o), &seeds);
+    }
     const QualityResult q = quality->clean_around(seeds);
     r.collapsed = q.collapses;
     r.unresolved = q.unresolved;

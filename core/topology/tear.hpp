@@ -6,11 +6,14 @@
 // split point toward the opposite vertex for `crack_fraction` of the way and ends there, inside the
 // triangle (a crack tip), instead of cutting through to the far vertex. The springs at the crack
 // tip then carry the load, so the next tear starts there: propagate_tears tears the most strained
-// spring, re-measures, and repeats — the crack grows from where the forceps pull.
+// spring, re-measures, and repeats — the crack grows from where the forceps pull. Where a
+// triangle is too small to hold a tip (its spoke shorter than twice min_spring_length_mm), the
+// crack runs through to its opposite vertex on that side instead: a tear always opens.
 //
 // Built on Surface::split_edge / disconnect_edge / separate_vertex_fans: rest vectors by vector
-// addition, mass exact, check_surface() passes after every tear. Surface::tear_edge (used by the
-// solver's own end-of-step tearing) keeps its older behaviour; see core/topology/README.md.
+// addition, mass exact, check_surface() passes after every tear. The solver's own end-of-step
+// tears use it too, through the topology hook (clean_topology.hpp); Surface::tear_edge is the
+// solver's fallback for surfaces without a hook.
 #include <cstdint>
 
 #include "core/common/status.hpp"
