@@ -22,15 +22,6 @@ using namespace vitreo::core::test;
 
 namespace {
 
-// What the cleanup after every operation guarantees (core/topology/quality.hpp).
-ValidityLimits quality_limits(const QualitySettings& q = {}) {
-  ValidityLimits l;
-  l.min_spring_rest_mm = q.min_spring_mm;
-  l.min_rest_angle_deg = q.min_angle_deg;
-  l.min_rest_area_mm2 = q.min_area_mm2();
-  return l;
-}
-
 struct Ops {
   Surface& s;
   Cutter cutter;

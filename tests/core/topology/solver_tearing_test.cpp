@@ -23,14 +23,6 @@ constexpr double kW = 4.0, kH = 3.0;
 constexpr int kCols = 16, kRows = 12;
 constexpr double kCell = kW / kCols;
 
-ValidityLimits quality_limits(const QualitySettings& q = {}) {
-  ValidityLimits l;
-  l.min_spring_rest_mm = q.min_spring_mm;
-  l.min_rest_angle_deg = q.min_angle_deg;
-  l.min_rest_area_mm2 = q.min_area_mm2();
-  return l;
-}
-
 TissueWorld free_world() {
   Environment env;
   env.apply_pressure = false;

@@ -91,4 +91,12 @@ bool long_tests() {
   return v != nullptr && v[0] != '\0' && v[0] != '0';
 }
 
+ValidityLimits quality_limits(const QualitySettings& q) {
+  ValidityLimits l;
+  l.min_spring_rest_mm = q.min_spring_mm;
+  l.min_rest_angle_deg = q.min_angle_deg;
+  l.min_rest_area_mm2 = q.min_area_mm2();
+  return l;
+}
+
 }  // namespace vitreo::core::test

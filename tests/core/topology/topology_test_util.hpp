@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "core/tissue/surface.hpp"
+#include "core/tissue/surface_validity.hpp"
+#include "core/topology/quality.hpp"
 
 namespace vitreo::core::test {
 
@@ -27,5 +29,9 @@ double distance_point_segments(const Vec3& p, const std::vector<Segment>& segs);
 double max_rest_vector_error(const Surface& s);
 
 bool long_tests();
+
+// What the cleanup after every operation guarantees (core/topology/quality.hpp), as limits for
+// check_surface.
+ValidityLimits quality_limits(const QualitySettings& q = {});
 
 }  // namespace vitreo::core::test
