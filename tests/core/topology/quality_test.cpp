@@ -36,14 +36,6 @@ Digest digest(const Surface& s) {
   return {s.topology_version(), s.vertex_count(), s.edge_count(), s.triangle_count(), s.total_mass(), s.total_rest_area(), p};
 }
 
-ValidityLimits limits(const QualitySettings& q) {
-  ValidityLimits l;
-  l.min_spring_rest_mm = q.min_spring_mm;
-  l.min_rest_angle_deg = q.min_angle_deg;
-  l.min_rest_area_mm2 = q.min_area_mm2();
-  return l;
-}
-
 // An interior spring of the sheet whose two ends are interior too.
 std::uint32_t interior_spring(const Surface& s) {
   for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
@@ -158,7 +150,7 @@ TEST(MeshQuality, RemovesSliversDownToTheFloorWithExactMassAndKeepsAnchors) {
   // The vertex next to the short springs is an anchor: the rule keeps it.
   ASSERT_TRUE(s.set_fixed(s.vertex_id(at(5, 3)), true));
   const QualitySettings q;
-  ASSERT_FALSE(check_surface(s, limits(q)).ok()) << "the sheet must start with slivers";
+  ASSERT_FALSE(check_surface(s, quality_limits(q)).ok()) << "the sheet must start with slivers";
   const double mass0 = s.total_mass(), area0 = s.total_rest_area();
   const VertexId anchor = s.vertex_id(at(5, 3));
   const Vec3 anchor_at = s.position(at(5, 3));
@@ -167,7 +159,7 @@ TEST(MeshQuality, RemovesSliversDownToTheFloorWithExactMassAndKeepsAnchors) {
   EXPECT_GE(r.collapses + r.dissolved, 2u);
   EXPECT_EQ(r.unresolved, 0u);
   EXPECT_EQ(r.fragments_removed, 0u);
-  const auto report = check_surface(s, limits(q));
+  const auto report = check_surface(s, quality_limits(q));
   EXPECT_TRUE(report.ok()) << report.summary();
   EXPECT_NEAR(s.total_mass(), mass0, 1e-12 * mass0);
   EXPECT_NEAR(s.total_rest_area(), area0, 1e-12 * area0);
