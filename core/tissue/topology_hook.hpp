@@ -18,9 +18,7 @@ namespace vitreo::core {
 
 struct TopologyHookResult {
   Status status = Status::ok();
-  std::uint32_t collapsed = 0;   // slivers the cleanup removed by collapse
-  std::uint32_t unresolved = 0;  // poor triangles no rule could fix
-  double removed_mass_g = 0.0;   // lone sliver fragments removed as material (exact)
+  double removed_mass_g = 0.0;  // lone sliver fragments removed as material (exact)
 };
 
 class TopologyHook {

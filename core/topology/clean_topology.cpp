@@ -23,8 +23,6 @@ TopologyHookResult CleanTopology::tear(EdgeId spring) {
 TopologyHookResult CleanTopology::clean_around(std::span<const std::uint32_t> vertices) {
   const QualityResult q = quality_.clean_around(vertices);
   TopologyHookResult r;
-  r.collapsed = q.collapses;
-  r.unresolved = q.unresolved;
   r.removed_mass_g = q.removed_mass_g;
   return r;
 }
