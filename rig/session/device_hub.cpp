@@ -86,11 +86,17 @@ void DeviceHub::run_sims() {
 void DeviceHub::run_drivers() {
   std::uint64_t next_status = 0;
   while (running_.load(std::memory_order_acquire)) {
-    for (auto& d : devices_) d->driver->poll(0);
+    bool changed = false;
+    for (auto& d : devices_) {
+      d->driver->poll(0);
+      changed = changed || d->driver->session().state() != d->last_state;
+    }
     const std::uint64_t now = clock_.now_us();
-    if (now >= next_status) {
+    // 10 Hz (rig/telemetry/CHANNELS.md), and at once when a link changes state: a loss that the
+    // driver recovers from within 100 ms must still reach the technician's telemetry.
+    if (now >= next_status || changed) {
       publish_status(now);
-      next_status = now + 100'000;  // 10 Hz (rig/telemetry/CHANNELS.md)
+      next_status = now + 100'000;
     }
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
@@ -127,6 +133,7 @@ void DeviceHub::publish_status(std::uint64_t) {
     s.sequence_gaps = static_cast<std::int64_t>(st.drops);
     s.reconnects = static_cast<std::int64_t>(st.reconnects);
     status_out_->push(s);
+    d->last_state = session.state();
   }
 }
 

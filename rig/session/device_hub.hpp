@@ -74,7 +74,7 @@ class DeviceHub {
     std::int64_t sequence = 0;
     std::int64_t last_taken = -1;
     std::atomic<int> plug_request{0};  // +1 plug, -1 unplug
-    drivers::LinkState last_state = drivers::LinkState::lost;
+    drivers::LinkState last_state = drivers::LinkState::lost;  // as last published (driver thread)
   };
   void run_sims();
   void run_drivers();
