@@ -82,9 +82,13 @@ bool TissueWorld::update_velocities(double h) {
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
     std::fill(sc.block_max_speed2.begin(), sc.block_max_speed2.end(), 0.0);
+    std::fill(sc.block_max_move2.begin(), sc.block_max_move2.end(), 0.0);
     for_each_awake_vertex(s, [&](std::uint32_t v) {
+      const Vec3 moved = view.x[v] - sc.previous[v];
+      double& move2 = sc.block_max_move2[v / Surface::kSleepBlock];  // kinematic vertices move too
+      move2 = std::max(move2, moved.squaredNorm());
       if (view.inverse_mass[v] == 0.0) return;
-      view.v[v] = (view.x[v] - sc.previous[v]) * inv_h;
+      view.v[v] = moved * inv_h;
       if (sc.wall_touched[v]) {
         sc.wall_touched[v] = 0;
         const Vec3 radial = view.x[v] - wall_.center();
@@ -96,6 +100,9 @@ bool TissueWorld::update_velocities(double h) {
       double& m = sc.block_max_speed2[v / Surface::kSleepBlock];
       m = std::max(m, view.v[v].squaredNorm());
     });
+    for (std::uint32_t b = 0; b < s.block_count(); ++b) {
+      if (sc.block_max_move2[b] > 0.0) sc.block_step_drift_mm[b] += std::sqrt(sc.block_max_move2[b]);
+    }
   }
   return std::isfinite(checksum);
 }
@@ -153,7 +160,7 @@ void TissueWorld::finish_sleep() {
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     Surface& s = *surfaces_[si];
     Scratch& sc = scratch_[si];
-    s.note_awake_blocks_moved();  // before any falls asleep: they moved during this step
+    s.note_awake_blocks_moved(sc.block_step_drift_mm);
     if (settings_.sleeping) {
       s.update_sleep(sc.block_max_speed2, sleep2, static_cast<std::uint32_t>(settings_.sleep_after_steps));
     }
@@ -272,6 +279,7 @@ StepReport TissueWorld::step(double dt_s) {
 
   prepare_sleep_groups();
   save_rollback();
+  for (auto& sc : scratch_) std::fill(sc.block_step_drift_mm.begin(), sc.block_step_drift_mm.end(), 0.0);
   const int substeps = settings_.substeps;
   const double h = dt_s / substeps;
   compute_external_accelerations(h);

@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "core/common/prefault.hpp"
 #include "core/common/validate.hpp"
 
 namespace vitreo::core {
@@ -46,16 +47,14 @@ Surface::Surface(const SurfaceDescription& d)
   next_corner_.reserve(3 * static_cast<std::size_t>(tcap));
   // Touch the reserved memory now, so that a cut taking new slots during the simulation does not
   // pay the operating system's first-touch page faults (tens of µs per stroke otherwise).
-  auto prefault = [](auto&... vecs) {
-    ((vecs.resize(vecs.capacity()), vecs.clear()), ...);
-  };
-  prefault(x_, v_, rest_, mass_, inverse_mass_, extra_mass_, vertex_area_, vertex_alive_, fixed_, vertex_generation_,
-           first_corner_, free_vertices_, edge_v_, edge_t_, base_rest_vec_, rest_vec_, rest_len_, stiffness_,
-           edge_traction_, edge_alive_, edge_is_line_, edge_generation_, free_edges_, tri_v_, tri_e_, tri_rest_area_,
-           tri_alive_, tri_generation_, free_triangles_, next_corner_);
+  touch_reserved(x_, v_, rest_, mass_, inverse_mass_, extra_mass_, vertex_area_, vertex_alive_, fixed_,
+                 vertex_generation_, first_corner_, free_vertices_, edge_v_, edge_t_, base_rest_vec_, rest_vec_,
+                 rest_len_, stiffness_, edge_traction_, edge_alive_, edge_is_line_, edge_generation_, free_edges_,
+                 tri_v_, tri_e_, tri_rest_area_, tri_alive_, tri_generation_, free_triangles_, next_corner_);
   block_awake_.assign((vcap + kSleepBlock - 1) / kSleepBlock, 1);
   block_quiet_steps_.assign(block_awake_.size(), 0);
   block_motion_.assign(block_awake_.size(), 0);
+  block_drift_mm_.assign(block_awake_.size(), 0.0);
 
   for (std::size_t i = 0; i < nv; ++i) {
     require_finite(mesh.positions[i], "surface '" + material_.name + "': vertex position");
@@ -139,6 +138,7 @@ std::uint32_t Surface::allocate_vertex() {
   x_[v] = v_[v] = rest_[v] = Vec3::Zero();
   mass_[v] = inverse_mass_[v] = extra_mass_[v] = vertex_area_[v] = 0.0;
   vertex_alive_[v] = 1;
+  ++block_motion_[v / kSleepBlock];  // the caller places it: spatial indexes must look again
   fixed_[v] = 0;
   first_corner_[v] = kNone;
   ++live_vertices_;
@@ -343,6 +343,7 @@ Status Surface::set_fixed_position(VertexId id, const Vec3& p) {
   if (!is_finite(p)) return Status::error("set_fixed_position: non-finite position");
   x_[id.index] = p;
   wake_vertex(id.index);
+  ++block_motion_[id.index / kSleepBlock];  // moved by hand: spatial indexes must look again
   return Status::ok();
 }
 
@@ -351,6 +352,7 @@ Status Surface::set_position(VertexId id, const Vec3& p) {
   if (!is_finite(p)) return Status::error("set_position: non-finite position");
   x_[id.index] = p;
   wake_vertex(id.index);
+  ++block_motion_[id.index / kSleepBlock];  // moved by hand: spatial indexes must look again
   return Status::ok();
 }
 
@@ -418,8 +420,8 @@ void Surface::wake_all() {
   note_all_blocks_moved();
 }
 
-void Surface::note_awake_blocks_moved() {
-  for (std::uint32_t b = 0; b < block_count(); ++b) block_motion_[b] += block_awake_[b];
+void Surface::note_awake_blocks_moved(std::span<const double> step_drift_mm) {
+  for (std::uint32_t b = 0; b < block_count(); ++b) block_drift_mm_[b] += step_drift_mm[b];
 }
 
 void Surface::note_all_blocks_moved() {

@@ -236,19 +236,29 @@ class Surface {
   std::uint32_t block_count() const { return static_cast<std::uint32_t>(block_awake_.size()); }
   bool block_awake(std::uint32_t b) const { return block_awake_[b] != 0; }
   bool vertex_awake(std::uint32_t v) const { return block_awake_[v / kSleepBlock] != 0; }
+  // Waking does not move anything: what places a vertex (a new slot, set_position, a restore)
+  // bumps block_motion itself.
   void wake_vertex(std::uint32_t v) {
     block_awake_[v / kSleepBlock] = 1;
     block_quiet_steps_[v / kSleepBlock] = 0;
-    ++block_motion_[v / kSleepBlock];
   }
   void wake_all();
-  // Motion counters for spatial indexes (core/topology/vertex_index.hpp): block b's counter
-  // changes whenever its vertices may have moved — it was woken (every call that moves, adds or
-  // changes a vertex wakes it) or it was awake during a step (note_awake_blocks_moved, called by
-  // the solver after each step). A block whose counter is unchanged has not moved, so an index
-  // only refits the blocks that did. Not part of the state: a restored snapshot bumps them all.
+  // Motion bounds for spatial indexes (core/topology/vertex_index.hpp), in two parts:
+  //  - block_motion(b) changes whenever b's vertices may have moved other than by the solver's
+  //    steps: a vertex was added in one of its slots (every new vertex is placed there: a split,
+  //    a tear, a separated copy) or placed by hand (set_position), or a snapshot was restored.
+  //    Where it changed, an index knows nothing and must look again. Waking a block, or changing
+  //    its vertices' springs, masses or links, moves nothing and leaves it as it was.
+  //  - block_drift_mm(b) only grows, by at least how far any vertex of b moved during each step
+  //    (the solver reports each substep's largest displacement: note_awake_blocks_moved). Where
+  //    block_motion(b) is unchanged since an index read drift d0, every vertex of b lies within
+  //    block_drift_mm(b) − d0 of where the index saw it: a box grown by that much still holds
+  //    them, so a query far from it need not look again (tissue that only settles by micrometres
+  //    a step is not re-read every step).
+  // Not part of the state: a restored snapshot bumps every block_motion.
   std::uint32_t block_motion(std::uint32_t b) const { return block_motion_[b]; }
-  void note_awake_blocks_moved();
+  double block_drift_mm(std::uint32_t b) const { return block_drift_mm_[b]; }
+  void note_awake_blocks_moved(std::span<const double> step_drift_mm);
   void note_all_blocks_moved();
   // Called by the solver at the end of a step with each block's largest squared speed.
   void update_sleep(std::span<const double> block_max_speed2, double sleep_speed2, std::uint32_t steps_to_sleep);
@@ -326,6 +336,7 @@ class Surface {
   std::vector<std::uint8_t> block_awake_;
   std::vector<std::uint16_t> block_quiet_steps_;
   std::vector<std::uint32_t> block_motion_;  // see block_motion()
+  std::vector<double> block_drift_mm_;       // see block_drift_mm()
   std::uint64_t topology_version_ = 0;
   std::uint32_t line_springs_ = 0;
 };

@@ -160,9 +160,11 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
       make_triangle({m, a, s.o}, {e_am, s.e_ao, e_mo}, t * s.area);
     }
   }
-  refresh_around(m);
-  update_vertex_mass(a);  // a boundary spring with no triangle leaves a and b out of m's fan
-  update_vertex_mass(b);
+  refresh_around(m);  // with a triangle on the spring, a and b are in m's fan
+  if (n == 0) {        // a spring with no triangle leaves them out
+    update_vertex_mass(a);
+    update_vertex_mass(b);
+  }
   r.vertex = m;
   return r;
 }

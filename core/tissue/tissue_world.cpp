@@ -69,6 +69,8 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.block_was_awake.assign(blocks, 0);
   s.wake_request.assign(blocks, 0);
   s.block_max_speed2.assign(blocks, 0.0);
+  s.block_max_move2.assign(blocks, 0.0);
+  s.block_step_drift_mm.assign(blocks, 0.0);
   s.block_sleep_serial.assign(blocks, 0);
   s.wake_key.assign(surface->edge_capacity(), ~std::uint64_t{0});
   s.wake_length.assign(surface->edge_capacity(), 0.0);

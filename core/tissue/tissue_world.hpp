@@ -296,6 +296,10 @@ class TissueWorld {
     std::vector<std::uint8_t> block_was_awake;  // awake during the previous step
     std::vector<std::uint8_t> wake_request;     // set during a step, applied at its end
     std::vector<double> block_max_speed2;
+    // Largest displacement² of each block's vertices in the current substep, and their sum (of
+    // the roots) over this step's substeps: how far any vertex of the block can have moved, for
+    // Surface::block_drift_mm. Not state: reset at the start of every step.
+    std::vector<double> block_max_move2, block_step_drift_mm;
     // What a sleeping block's springs to awake vertices looked like when it fell asleep: each
     // block counts its sleeps, and a spring remembers its length for (block, count) — the first
     // step it is packed with that block asleep (pack_springs). A sleeping block wakes when the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/common/prefault.hpp"
 #include "core/common/validate.hpp"
 #include "core/topology/geometry.hpp"
 
@@ -32,12 +33,13 @@ Cutter::Cutter(Surface& surface, CutSettings settings)
   separated_.assign(nv, 0);
   edge_stamp_.assign(ne, 0);
   triangle_stamp_.assign(nt, 0);
-  candidates_.reserve(nv);
-  on_cut_.reserve(nv);
-  triangles_.reserve(nt);
-  edges_.reserve(ne);
-  crossings_.reserve(ne);
-  to_open_.reserve(ne);
+  // Scratch sized for the worst case and touched now, so no stroke allocates or takes a page fault.
+  reserve_touched(candidates_, nv);
+  reserve_touched(on_cut_, nv);
+  reserve_touched(triangles_, nt);
+  reserve_touched(edges_, ne);
+  reserve_touched(crossings_, ne);
+  reserve_touched(to_open_, ne);
   double longest = 0.0;
   for (std::uint32_t e = 0; e < surface.edge_slots(); ++e) {
     if (surface.edge_alive(e)) longest = std::max(longest, surface.edge_rest_length(e));
@@ -73,10 +75,22 @@ void Cutter::mark(std::uint32_t v) {
 void Cutter::gather_candidates() {
   candidates_.clear();
   const Surface& s = surface_;
+  const double band = settings_.band_mm;
   const auto wanted = [&](std::uint32_t v) {
     const Vec3& x = s.position(v);
-    if (!near_swept(x, margin_mm_)) return;
+    // near_swept(x, margin) and near_swept(x, band) at once, each exact distance at most once.
+    bool candidate = false, on_surface = false;
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (!swept_valid_[k]) continue;
+      const double plane = std::abs(swept_normal_[k].dot(x - swept_[k][0]));
+      if (plane > margin_mm_ || (candidate && (on_surface || plane > band))) continue;
+      const double d2 = (x - closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2])).squaredNorm();
+      candidate = candidate || d2 <= margin_mm_ * margin_mm_;
+      on_surface = on_surface || (plane <= band && d2 <= band * band);
+    }
+    if (!candidate) return;
     candidates_.push_back(v);
+    if (on_surface) mark(v);  // the vertex and grazing cases
     std::uint8_t mask = 0;
     for (std::size_t k = 0; k < rim_.size(); ++k) {
       if (topology::distance_to_segment(x, rim_[k][0], rim_[k][1]) <= margin_mm_) mask |= static_cast<std::uint8_t>(1u << k);
@@ -157,13 +171,8 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   ++stamp_;
   on_cut_.clear();
   rim_ = {{{p0, q0}, {p1, q1}, {p0, p1}, {q0, q1}}};
-  gather_candidates();
+  gather_candidates();  // also marks the vertices on the swept surface
   gather_edges();
-
-  // Vertices on the swept surface (vertex and grazing cases).
-  for (auto v : candidates_) {
-    if (near_swept(s.position(v), band)) mark(v);
-  }
 
   // Ends: the quad's boundary passing through the surface.
   const auto& boundary = rim_;
@@ -207,7 +216,8 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     }
   }
 
-  // Crossings, first estimate (for the capacity check only).
+  // Crossings of the springs found so far (inserting the ends below only adds springs around the
+  // new end vertices; the others keep their crossings, as nothing moves).
   auto crossing = [&](std::uint32_t e, double& t) {
     const auto [a, b] = s.edge_vertices(e);
     const Vec3 &xa = s.position(a), &xb = s.position(b);
@@ -223,11 +233,12 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     }
     return false;
   };
-  std::uint32_t ncross = 0;
+  crossings_.clear();
   for (auto e : edges_) {
     double t;
-    if (crossing(e, t)) ++ncross;
+    if (crossing(e, t)) crossings_.push_back({s.edge_id(e), t});
   }
+  const auto ncross = static_cast<std::uint32_t>(crossings_.size());
   const std::uint32_t k = nends + ncross + static_cast<std::uint32_t>(on_cut_.size()) + 2;
   if (!s.has_room(3 * k, 6 * k, 3 * k)) {
     r.status = Status::error("cut: pools full (raise the surface capacity)");
@@ -236,6 +247,9 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   if (nends == 0 && ncross == 0 && on_cut_.empty()) return r;  // the blade missed the tissue
 
   // 1. Insert the ends.
+  std::array<std::uint32_t, 32> created{};  // end vertices made by splitting
+  std::array<std::uint32_t, 32> end_vertices{};  // those and the ones snapped onto
+  std::uint32_t ncreated = 0, nend_vertices = 0;
   for (std::uint32_t i = 0; i < nends; ++i) {
     const Vec3& y = ends[i];
     std::uint32_t best = kNone;
@@ -290,6 +304,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
       const auto split = s.split_edge(s.edge_id(e), t);
       if (!split.status) continue;
       nv = split.vertex;
+      created[ncreated++] = nv;
       ++r.springs_split;
     } else {
       const double sum = w[0] + w[1] + w[2];
@@ -297,10 +312,12 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
       const auto split = s.split_triangle(s.triangle_id(best), w);
       if (!split.status) continue;
       nv = split.vertex;
+      created[ncreated++] = nv;
     }
     if (nv != kNone && cut_stamp_[nv] != stamp_) {
       mark(nv);
       candidates_.push_back(nv);
+      end_vertices[nend_vertices++] = nv;
       ++r.end_points;
       // The triangles made by the split, for the next end's search.
       s.for_each_triangle_of(nv, [&](std::uint32_t t, std::uint32_t) {
@@ -310,15 +327,41 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   }
 
   // 2. Crossings: snap onto a vertex within the tolerance, otherwise split the spring there.
-  gather_edges();
-  crossings_.clear();
-  for (auto e : edges_) {
-    double t;
-    if (!crossing(e, t)) continue;
-    const auto [a, b] = s.edge_vertices(e);
+  // The springs around the end vertices join the search: those the ends added (each joins a
+  // created end vertex: split_edge and split_triangle only add springs to their new vertex), and
+  // old ones no candidate reached before.
+  const std::uint32_t first_round = edge_round_;
+  ++edge_round_;
+  auto is_created = [&](std::uint32_t v) {
+    for (std::uint32_t i = 0; i < ncreated; ++i) {
+      if (created[i] == v) return true;
+    }
+    return false;
+  };
+  for (std::uint32_t i = 0; i < nend_vertices; ++i) {
+    if (!s.vertex_alive(end_vertices[i])) continue;
+    s.for_each_triangle_of(end_vertices[i], [&](std::uint32_t tri, std::uint32_t) {
+      for (auto e : s.triangle_edges(tri)) {
+        const bool seen_before = edge_stamp_[e] == first_round;
+        if (edge_stamp_[e] == edge_round_) continue;
+        edge_stamp_[e] = edge_round_;
+        const auto [a, b] = s.edge_vertices(e);
+        if (!is_created(a) && !is_created(b) && seen_before) continue;  // in the first search
+        double t;
+        if (crossing(e, t) && crossings_.size() < crossings_.capacity()) crossings_.push_back({s.edge_id(e), t});
+      }
+    });
+  }
+  // Snap the crossings near a vertex (in order; a snapped vertex settles its other springs).
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < crossings_.size(); ++i) {
+    const Crossing c = crossings_[i];
+    if (!s.is_current(c.edge)) continue;  // split by an end
+    const double t = c.t;
+    const auto [a, b] = s.edge_vertices(c.edge.index);
     if (cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;
     // Band in the current shape, the floor on pieces in the rest shape (what the springs keep).
-    const double len = (s.position(b) - s.position(a)).norm(), rest = s.edge_rest_length(e);
+    const double len = (s.position(b) - s.position(a)).norm(), rest = s.edge_rest_length(c.edge.index);
     const double floor_mm = settings_.min_piece_mm;
     if (t < snap || t * len <= band || t * rest <= floor_mm) {
       mark(a);
@@ -327,9 +370,10 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
       mark(b);
       ++r.snapped;
     } else {
-      crossings_.push_back({s.edge_id(e), t});
+      crossings_[kept++] = c;
     }
   }
+  crossings_.resize(kept);
   for (const auto& c : crossings_) {
     const auto [a, b] = s.edge_vertices(c.edge.index);
     if (!s.is_current(c.edge) || cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;

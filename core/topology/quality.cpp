@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/common/prefault.hpp"
 #include "core/common/validate.hpp"
 
 namespace vitreo::core {
@@ -42,9 +43,9 @@ bool is_poor_triangle(const Surface& s, std::uint32_t t, const QualitySettings& 
 
 MeshQuality::MeshQuality(Surface& surface, QualitySettings settings) : surface_(surface), settings_(settings) {
   settings_.validate();
-  work_.reserve(surface.vertex_capacity());
-  next_.reserve(surface.vertex_capacity());
-  seeds_.reserve(surface.vertex_capacity());
+  reserve_touched(work_, surface.vertex_capacity());
+  reserve_touched(next_, surface.vertex_capacity());
+  reserve_touched(seeds_, surface.vertex_capacity());
   tri_stamp_.assign(surface.edge_capacity(), 0);  // triangle capacity is below the spring capacity
 }
 

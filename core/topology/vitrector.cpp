@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/common/units.hpp"
+#include "core/common/prefault.hpp"
 #include "core/common/validate.hpp"
 
 namespace vitreo::core {
@@ -24,13 +25,13 @@ Vitrector::Vitrector(Surface& surface, VitrectorSettings settings)
     : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality) {
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
-  samples_.reserve(nv);
-  inside_.reserve(nv);
+  reserve_touched(samples_, nv);
+  reserve_touched(inside_, nv);
   stamp_.assign(nv, 0);
   phi_.assign(nv, 0.0);
-  triangles_.reserve(ne);
+  reserve_touched(triangles_, ne);
   tri_stamp_.assign(ne, 0);
-  crossings_.reserve(ne);
+  reserve_touched(crossings_, ne);
 }
 
 Status Vitrector::set_pose(const Vec3& port, const Vec3& direction) {

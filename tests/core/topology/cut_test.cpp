@@ -2,6 +2,7 @@
 // swept path's intersection with the sheet and the new boundary), exact mass, rest vectors
 // consistent with the undeformed sheet, the sideways blade and scissors, refusals.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <numbers>
@@ -16,16 +17,13 @@ using namespace vitreo::core::test;
 
 namespace {
 
-constexpr double kW = 4.0, kH = 3.0;
-constexpr int kCols = 16, kRows = 12;
-constexpr double kCell = kW / kCols;  // 0.25 mm
 
 // A vertical blade (along z) through the sheet at xy.
 BladeEdge vertical(double x, double y) { return {Vec3(x, y, -0.5), Vec3(x, y, 0.5)}; }
 
 // Hausdorff distance between a path on the sheet (its part inside the sheet) and the new boundary.
 double hausdorff(const Surface& s, const std::vector<Vec3>& path) {
-  const auto boundary = new_boundary(s, kW, kH);
+  const auto boundary = new_boundary(s, kSheetW, kSheetH);
   if (boundary.empty()) return INFINITY;
   double d = 0.0;
   for (const auto& seg : boundary) {
@@ -34,7 +32,7 @@ double hausdorff(const Surface& s, const std::vector<Vec3>& path) {
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
     for (int k = 0; k <= 20; ++k) {
       const Vec3 p = path[i] + (k / 20.0) * (path[i + 1] - path[i]);
-      if (p.x() <= 1e-9 || p.y() <= 1e-9 || p.x() >= kW - 1e-9 || p.y() >= kH - 1e-9) continue;
+      if (p.x() <= 1e-9 || p.y() <= 1e-9 || p.x() >= kSheetW - 1e-9 || p.y() >= kSheetH - 1e-9) continue;
       d = std::max(d, distance_point_segments(p, boundary));
     }
   }
@@ -46,7 +44,7 @@ struct Fixture {
   Cutter cutter;
   double mass0, area0;
   explicit Fixture(double jitter = 0.0, unsigned seed = 1)
-      : s(sheet(kW, kH, kCols, kRows, jitter, seed)), cutter(s), mass0(s.total_mass()), area0(s.total_rest_area()) {}
+      : s(sheet(kSheetW, kSheetH, kSheetCols, kSheetRows, jitter, seed)), cutter(s), mass0(s.total_mass()), area0(s.total_rest_area()) {}
   void expect_valid_and_exact(const char* what) {
     const auto report = check_surface(s, ValidityLimits{});
     EXPECT_TRUE(report.ok()) << what << ": " << report.summary();
@@ -61,14 +59,14 @@ struct Fixture {
 TEST(Cut, AStraightStrokeAcrossTheSheetSplitsItExactlyAlongThePath) {
   Fixture f(0.3, 3);
   // Oblique, so it crosses springs at arbitrary parameters (edge–edge cases).
-  const Vec3 a(-0.3, 0.7, 0.0), b(kW + 0.3, 2.2, 0.0);
+  const Vec3 a(-0.3, 0.7, 0.0), b(kSheetW + 0.3, 2.2, 0.0);
   const auto r = f.cutter.sweep(vertical(a.x(), a.y()), vertical(b.x(), b.y()));
   ASSERT_TRUE(r.status) << r.status.message();
   EXPECT_GT(r.springs_split + r.snapped, 15u);
   EXPECT_GT(r.springs_opened, 15u);
   f.expect_valid_and_exact("straight");
   EXPECT_EQ(components(f.s), 2u) << "a stroke across the whole sheet must part it";
-  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kSheetCell);
 }
 
 TEST(Cut, APartialStrokeEndsInsideTrianglesAndKeepsTheSheetWhole) {
@@ -79,7 +77,7 @@ TEST(Cut, APartialStrokeEndsInsideTrianglesAndKeepsTheSheetWhole) {
   EXPECT_EQ(r.end_points, 2u) << "the blade at its start and end poses each leave a cut end inside the sheet";
   f.expect_valid_and_exact("partial");
   EXPECT_EQ(components(f.s), 1u);
-  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kSheetCell);
 }
 
 TEST(Cut, AStrokeWhollyInsideOneTriangleOpensASlit) {
@@ -93,19 +91,19 @@ TEST(Cut, AStrokeWhollyInsideOneTriangleOpensASlit) {
   EXPECT_GT(f.s.triangle_count(), tris0);
   EXPECT_GE(r.springs_opened, 2u);
   f.expect_valid_and_exact("inside one triangle");
-  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kSheetCell);
 }
 
 TEST(Cut, VertexToVertexAlongGridLinesGrazesExistingSprings) {
   Fixture f;
   // Along y = 1.5 (a row of grid vertices): no spring is crossed, the springs along it are opened.
-  const Vec3 a(-0.2, 1.5, 0.0), b(kW + 0.2, 1.5, 0.0);
+  const Vec3 a(-0.2, 1.5, 0.0), b(kSheetW + 0.2, 1.5, 0.0);
   const auto verts0 = f.s.vertex_count();
   const auto r = f.cutter.sweep(vertical(a.x(), a.y()), vertical(b.x(), b.y()));
   ASSERT_TRUE(r.status) << r.status.message();
   EXPECT_EQ(r.springs_split, 0u);
-  EXPECT_EQ(r.springs_opened, static_cast<std::uint32_t>(kCols));
-  EXPECT_EQ(f.s.vertex_count(), verts0 + kCols + 1) << "each vertex on the line gets a copy";
+  EXPECT_EQ(r.springs_opened, static_cast<std::uint32_t>(kSheetCols));
+  EXPECT_EQ(f.s.vertex_count(), verts0 + kSheetCols + 1) << "each vertex on the line gets a copy";
   f.expect_valid_and_exact("grazing");
   EXPECT_EQ(components(f.s), 2u);
   EXPECT_LE(hausdorff(f.s, {a, b}), 1e-9);
@@ -120,7 +118,7 @@ TEST(Cut, EdgeVertexAndVertexInteriorCasesStayAccurate) {
   ASSERT_TRUE(r.status) << r.status.message();
   f.expect_valid_and_exact("edge-vertex");
   EXPECT_EQ(components(f.s), 1u);
-  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {a, b}), 0.1 * kSheetCell);
 }
 
 TEST(Cut, ACurvedStrokeInManySmallSweepsFollowsTheArc) {
@@ -139,7 +137,7 @@ TEST(Cut, ACurvedStrokeInManySmallSweepsFollowsTheArc) {
     ASSERT_TRUE(report.ok()) << "after sweep " << i << ": " << report.summary();
   }
   f.expect_valid_and_exact("curved");
-  EXPECT_LE(hausdorff(f.s, path), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, path), 0.1 * kSheetCell);
 }
 
 TEST(Cut, ABladeDippingIntoTheSheetCutsOnlyWhereItPassesThrough) {
@@ -152,17 +150,17 @@ TEST(Cut, ABladeDippingIntoTheSheetCutsOnlyWhereItPassesThrough) {
   ASSERT_TRUE(r.status) << r.status.message();
   f.expect_valid_and_exact("dipping");
   EXPECT_EQ(components(f.s), 1u);
-  EXPECT_LE(hausdorff(f.s, {Vec3(2.0, 1.6, 0.0), Vec3(3.5, 1.6, 0.0)}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {Vec3(2.0, 1.6, 0.0), Vec3(3.5, 1.6, 0.0)}), 0.1 * kSheetCell);
 }
 
 TEST(Cut, NothingSnapsFartherThanTheDocumentedTolerance) {
   Fixture f(0.3, 11);
-  const Vec3 a(-0.2, 0.4, 0.0), b(kW + 0.2, 2.6, 0.0);
+  const Vec3 a(-0.2, 0.4, 0.0), b(kSheetW + 0.2, 2.6, 0.0);
   ASSERT_TRUE(f.cutter.sweep(vertical(a.x(), a.y()), vertical(b.x(), b.y())).status);
   // Every vertex of the new boundary lies on the path within max(band, snap_fraction × cell
   // diagonal) (the jittered cells' springs are at most ~1.6 cells long).
-  const double tol = f.cutter.settings().snap_fraction * 1.6 * std::sqrt(2.0) * kCell;
-  for (const auto& seg : new_boundary(f.s, kW, kH)) {
+  const double tol = f.cutter.settings().snap_fraction * 1.6 * std::sqrt(2.0) * kSheetCell;
+  for (const auto& seg : new_boundary(f.s, kSheetW, kSheetH)) {
     EXPECT_LE(distance_point_polyline(seg.a, {a, b}), tol);
     EXPECT_LE(distance_point_polyline(seg.b, {a, b}), tol);
   }
@@ -211,13 +209,13 @@ TEST(Cut, InvalidRequestsAreRefusedAndChangeNothing) {
 }
 
 TEST(Cut, FullPoolsAreRefusedBeforeAnythingChanges) {
-  SurfaceDescription d = sheet(kW, kH, kCols, kRows);
+  SurfaceDescription d = sheet(kSheetW, kSheetH, kSheetCols, kSheetRows);
   d.capacity.growth_fraction = 0.0;
   d.capacity.minimum_extra = 4;
   Surface s(d);
   Cutter cutter(s);
   const auto version = s.topology_version();
-  const auto r = cutter.sweep(vertical(-0.2, 0.7), vertical(kW + 0.2, 2.3));
+  const auto r = cutter.sweep(vertical(-0.2, 0.7), vertical(kSheetW + 0.2, 2.3));
   EXPECT_FALSE(r.status);
   EXPECT_NE(r.status.message().find("pools full"), std::string::npos);
   EXPECT_EQ(s.topology_version(), version);
@@ -239,7 +237,7 @@ TEST(SidewaysBlade, CutsInStrokesAlongItsTipPath) {
   EXPECT_GE(strokes, 6u);
   f.expect_valid_and_exact("sideways blade");
   EXPECT_EQ(components(f.s), 1u);
-  EXPECT_LE(hausdorff(f.s, {Vec3(0.8, 1.3, 0), Vec3(3.2, 1.3, 0)}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {Vec3(0.8, 1.3, 0), Vec3(3.2, 1.3, 0)}), 0.1 * kSheetCell);
   EXPECT_FALSE(blade.move_to(Vec3(std::nan(""), 0, 0), down).status);
 }
 
@@ -261,9 +259,36 @@ TEST(Scissors, CutBetweenTheBladesAsTheyClose) {
   }
   EXPECT_GT(f.s.vertex_count(), verts0);
   f.expect_valid_and_exact("scissors");
-  EXPECT_LE(hausdorff(f.s, {Vec3(0, 1.45, 0), Vec3(1.4, 1.45, 0)}), 0.1 * kCell);
+  EXPECT_LE(hausdorff(f.s, {Vec3(0, 1.45, 0), Vec3(1.4, 1.45, 0)}), 0.1 * kSheetCell);
   // Opening again cuts nothing.
   const auto version = f.s.topology_version();
   ASSERT_TRUE(scissors.set_pose(pivot, bisector, normal, 0.8).status);
   EXPECT_EQ(f.s.topology_version(), version);
+}
+
+// Real-time: once the cutter exists, strokes that take fresh pool slots (new vertices, springs,
+// triangles) take no page faults: the pools and scratch were written at construction
+// (core/common/prefault.hpp). Before, each stroke here took tens of first-touch faults (~10 µs each).
+TEST(Cut, StrokesTakeNoPageFaults) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer maps its shadow memory on first touch";
+#endif
+  auto minor_faults = [] {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return u.ru_minflt;
+  };
+  Surface s(sheet(12.0, 12.0, 96, 96));
+  Cutter cutter(s);
+  const std::uint32_t slots0 = s.vertex_slots();
+  auto stroke = [&](int i) {
+    const double x = 0.37 + 0.61 * i;
+    return cutter.sweep(vertical(x, 0.4), vertical(x + 0.2, 11.6));
+  };
+  ASSERT_TRUE(stroke(0).status);  // the first call may touch the code's own pages
+  const long before = minor_faults();
+  for (int i = 1; i < 18; ++i) ASSERT_TRUE(stroke(i).status);
+  const long after = minor_faults();
+  EXPECT_GT(s.vertex_slots(), slots0 + 17 * 100u);  // the strokes took many fresh slots
+  EXPECT_EQ(after - before, 0) << "page faults during 17 strokes";
 }

@@ -15,14 +15,8 @@
 using namespace vitreo::core;
 using namespace vitreo::core::test;
 
-namespace {
-constexpr double kW = 4.0, kH = 3.0;
-constexpr int kCols = 16, kRows = 12;
-constexpr double kCell = kW / kCols;
-}  // namespace
-
 TEST(Vitrector, RemovesWhatEntersTheRemovalHemisphereClippedAtItsBoundary) {
-  Surface s(sheet(kW, kH, kCols, kRows, 0.3, 21));
+  Surface s(sheet(kSheetW, kSheetH, kSheetCols, kSheetRows, 0.3, 21));
   const double mass0 = s.total_mass(), area0 = s.total_rest_area();
   VitrectorSettings vs;
   vs.removal_radius_mm = 0.6;
@@ -50,14 +44,14 @@ TEST(Vitrector, RemovesWhatEntersTheRemovalHemisphereClippedAtItsBoundary) {
     const Vec3 c = (s.position(tv[0]) + s.position(tv[1]) + s.position(tv[2])) / 3.0;
     EXPECT_GT((c - port).norm(), 0.6 - 1e-9);
   }
-  for (const auto& seg : new_boundary(s, kW, kH)) {
+  for (const auto& seg : new_boundary(s, kSheetW, kSheetH)) {
     const double ra = (seg.a - Vec3(port.x(), port.y(), 0)).norm();
-    EXPECT_NEAR(ra, rho, 0.05 * 1.6 * std::sqrt(2.0) * kCell + 1e-9);
+    EXPECT_NEAR(ra, rho, 0.05 * 1.6 * std::sqrt(2.0) * kSheetCell + 1e-9);
   }
 }
 
 TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
-  SurfaceDescription d = sheet(kW, kH, kCols, kRows);
+  SurfaceDescription d = sheet(kSheetW, kSheetH, kSheetCols, kSheetRows);
   Environment env;
   env.apply_pressure = false;
   env.gravity_mm_s2 = Vec3::Zero();
@@ -66,7 +60,7 @@ TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
   Surface& s = world.surface(si);
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
     const Vec3 p = s.rest_position(v);
-    if (p.x() == 0.0 || p.x() == kW) {
+    if (p.x() == 0.0 || p.x() == kSheetW) {
       ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
     }
   }
@@ -78,7 +72,7 @@ TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
   ASSERT_TRUE(vit.set_cut_rate(0.0));
   const double mass0 = s.total_mass();
   // Suction only: tissue under the port rises toward it, nothing is removed.
-  const std::uint32_t centre = 6 * (kCols + 1) + 8;
+  const std::uint32_t centre = 6 * (kSheetCols + 1) + 8;
   for (int i = 0; i < 200; ++i) {
     const auto r = vit.apply(1e-3);
     ASSERT_TRUE(r.status) << r.status.message();
@@ -115,7 +109,7 @@ TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
 }
 
 TEST(Vitrector, InvalidRequestsAreRefused) {
-  Surface s(sheet(kW, kH, kCols, kRows));
+  Surface s(sheet(kSheetW, kSheetH, kSheetCols, kSheetRows));
   Vitrector vit(s);
   EXPECT_FALSE(vit.apply(1e-3).status) << "no pose yet";
   EXPECT_FALSE(vit.set_pose(Vec3(std::nan(""), 0, 0), Vec3::UnitZ()));
@@ -156,9 +150,9 @@ TEST(Vitrector, InvalidRequestsAreRefused) {
 }
 
 TEST(Tear, ACrackOpensAtTheStrainedSpringAndEndsInsideTheAdjacentTriangles) {
-  Surface s(sheet(kW, kH, kCols, kRows));
+  Surface s(sheet(kSheetW, kSheetH, kSheetCols, kSheetRows));
   const double mass0 = s.total_mass();
-  const std::uint32_t a = 6 * (kCols + 1) + 8, b = a + 1;
+  const std::uint32_t a = 6 * (kSheetCols + 1) + 8, b = a + 1;
   const std::uint32_t e = s.find_edge(a, b);
   ASSERT_NE(e, kNone);
   const Vec3 mid = 0.5 * (s.position(a) + s.position(b));
@@ -171,20 +165,20 @@ TEST(Tear, ACrackOpensAtTheStrainedSpringAndEndsInsideTheAdjacentTriangles) {
   EXPECT_NEAR(s.total_mass(), mass0, 1e-12 * mass0);
   EXPECT_LT(max_rest_vector_error(s), 1e-12);
   // The new boundary: from the split point half way to each opposite vertex, no farther.
-  const auto boundary = new_boundary(s, kW, kH);
+  const auto boundary = new_boundary(s, kSheetW, kSheetH);
   ASSERT_EQ(boundary.size(), 4u);
   for (const auto& seg : boundary) {
     // Half way to an opposite vertex of the (right-angled) cells: at most half the cell diagonal.
-    EXPECT_LE((seg.a - mid).norm(), 0.5 * std::sqrt(1.25) * kCell + 1e-9);
-    EXPECT_LE((seg.b - mid).norm(), 0.5 * std::sqrt(1.25) * kCell + 1e-9);
+    EXPECT_LE((seg.a - mid).norm(), 0.5 * std::sqrt(1.25) * kSheetCell + 1e-9);
+    EXPECT_LE((seg.b - mid).norm(), 0.5 * std::sqrt(1.25) * kSheetCell + 1e-9);
   }
   EXPECT_FALSE(tear_spring(s, id).status) << "the torn spring's handle is stale";
 }
 
 TEST(Tear, PropagatesFromTheMostStrainedSpringWhereThePullIs) {
-  Surface s(sheet(kW, kH, kCols, kRows));
+  Surface s(sheet(kSheetW, kSheetH, kSheetCols, kSheetRows));
   // Pull a column of vertices near the middle sideways: the springs next to them strain most.
-  const std::uint32_t pulled = 6 * (kCols + 1) + 8;
+  const std::uint32_t pulled = 6 * (kSheetCols + 1) + 8;
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
     const Vec3 p = s.rest_position(v);
     if (p.x() > 2.0 + 1e-9) {
@@ -198,6 +192,6 @@ TEST(Tear, PropagatesFromTheMostStrainedSpringWhereThePullIs) {
   EXPECT_TRUE(report.ok()) << report.summary();
   // The first tear is at the pulled vertex.
   bool near_pull = false;
-  for (const auto& seg : new_boundary(s, kW, kH)) near_pull = near_pull || (seg.a - s.rest_position(pulled)).norm() < 1.01 * kCell;
+  for (const auto& seg : new_boundary(s, kSheetW, kSheetH)) near_pull = near_pull || (seg.a - s.rest_position(pulled)).norm() < 1.01 * kSheetCell;
   EXPECT_TRUE(near_pull);
 }

@@ -19,9 +19,6 @@ using namespace vitreo::core;
 using namespace vitreo::core::test;
 
 namespace {
-constexpr double kW = 4.0, kH = 3.0;
-constexpr int kCols = 16, kRows = 12;
-constexpr double kCell = kW / kCols;
 
 TissueWorld free_world() {
   Environment env;
@@ -51,13 +48,13 @@ std::uint32_t triangle_at(const Surface& s, double x, double y, Vec3& bary) {
 
 TEST(SolverTearing, ForcepsPullingASheetTearItAtTheGripAndEveryStepLeavesACleanMesh) {
   TissueWorld world = free_world();
-  SurfaceDescription d = sheet(kW, kH, kCols, kRows, 0.3, 7);
+  SurfaceDescription d = sheet(kSheetW, kSheetH, kSheetCols, kSheetRows, 0.3, 7);
   d.material.tear_strain = 0.3;
   const std::uint32_t si = world.add_surface(d);
   Surface& s = world.surface(si);
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
     const double x = s.rest_position(v).x();
-    if (x == 0.0 || x == kW) {
+    if (x == 0.0 || x == kSheetW) {
       ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
     }
   }
@@ -93,12 +90,12 @@ TEST(SolverTearing, ForcepsPullingASheetTearItAtTheGripAndEveryStepLeavesACleanM
   ASSERT_GE(tears.size(), 3u) << "the pull must tear the sheet";
   // The first tear is where the forceps pull (in the sheet's plane), not at the fixed edges.
   const auto planar = [](const Vec3& p) { return Vec3(p.x(), p.y(), 0.0); };
-  EXPECT_LT((planar(tears.front()) - grasp).norm(), 2.0 * kCell) << "first tear at " << tears.front().transpose();
+  EXPECT_LT((planar(tears.front()) - grasp).norm(), 2.0 * kSheetCell) << "first tear at " << tears.front().transpose();
   // The crack grows from there: every later tear lies within two cells of an earlier one.
   for (std::size_t i = 1; i < tears.size(); ++i) {
     double nearest = std::numeric_limits<double>::infinity();
     for (std::size_t j = 0; j < i; ++j) nearest = std::min(nearest, (planar(tears[i]) - planar(tears[j])).norm());
-    EXPECT_LT(nearest, 2.0 * kCell) << "tear " << i << " at " << tears[i].transpose() << " is not at the crack";
+    EXPECT_LT(nearest, 2.0 * kSheetCell) << "tear " << i << " at " << tears[i].transpose() << " is not at the crack";
   }
   const auto report = check_surface(s, limits);
   EXPECT_TRUE(report.ok()) << report.summary();
@@ -110,13 +107,13 @@ TEST(SolverTearing, ForcepsPullingASheetTearItAtTheGripAndEveryStepLeavesACleanM
 TEST(SolverTearing, CreepBelowTheQualityFloorIsCleanedUpAtTheStepBoundary) {
   auto run = [](bool hooked, std::uint32_t& collapsed_vertices) {
     TissueWorld world = free_world();
-    SurfaceDescription d = sheet(kW, kH, kCols, kRows);
+    SurfaceDescription d = sheet(kSheetW, kSheetH, kSheetCols, kSheetRows);
     d.material.tear_strain = INFINITY;
     d.material.plastic_yield_strain = 0.05;
     d.material.plastic_rate_per_s = 1000.0;  // creeps fully each step beyond the yield
     const std::uint32_t si = world.add_surface(d);
     Surface& s = world.surface(si);
-    const std::uint32_t u = 6 * (kCols + 1) + 8, v = u + 1;  // neighbours on a row
+    const std::uint32_t u = 6 * (kSheetCols + 1) + 8, v = u + 1;  // neighbours on a row
     EXPECT_TRUE(s.set_fixed(s.vertex_id(u), true));
     EXPECT_TRUE(s.set_fixed(s.vertex_id(v), true));
     EXPECT_TRUE(s.set_position(s.vertex_id(v), s.position(u) + Vec3(1e-3, 0.0, 0.0)));

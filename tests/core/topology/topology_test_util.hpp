@@ -13,6 +13,11 @@ namespace vitreo::core::test {
 // `jitter` of a cell when jitter > 0 (seeded), with room for many topology changes.
 SurfaceDescription sheet(double width_mm, double height_mm, int cols, int rows, double jitter = 0.0, unsigned seed = 1);
 
+// The sheet most topology tests cut, tear and suck: 4 × 3 mm in 16 × 12 cells of 0.25 mm.
+constexpr double kSheetW = 4.0, kSheetH = 3.0;
+constexpr int kSheetCols = 16, kSheetRows = 12;
+constexpr double kSheetCell = kSheetW / kSheetCols;
+
 // Number of connected pieces (triangles joined through shared springs).
 std::uint32_t components(const Surface& s);
 

@@ -46,23 +46,33 @@ std::uint32_t expect_exact(VertexIndex& index, const Surface& s, std::mt19937& r
   return refits;
 }
 
+// A sheet sagging under gravity from its pinned edge x = 0, in a world with the given settings.
+struct SaggingSheet {
+  TissueWorld world;
+  Surface& s;
+  SaggingSheet(const SurfaceDescription& d, const SolverSettings& settings)
+      : world(GlobeWall::sphere(Vec3::Zero(), 1e6), gravity_only(), settings), s(world.surface(world.add_surface(d))) {
+    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
+      if (s.rest_position(v).x() == 0.0) (void)s.set_fixed(s.vertex_id(v), true);
+    }
+  }
+  static Environment gravity_only() {
+    Environment env;
+    env.apply_pressure = false;
+    env.gravity_mm_s2 = Vec3(0.0, 0.0, -9810.0);
+    return env;
+  }
+};
+
 }  // namespace
 
 TEST(VertexIndex, ReportsExactlyTheVerticesInTheBoxWhileTheTissueMovesSleepsAndChanges) {
-  SurfaceDescription d = sheet(4.0, 3.0, 24, 18, 0.3, 3);
-  Environment env;
-  env.apply_pressure = false;
-  env.gravity_mm_s2 = Vec3(0.0, 0.0, -9810.0);
   SolverSettings settings;
   settings.sleep_after_steps = 5;  // so blocks fall asleep (and wake) within the test
   settings.sleep_speed_mm_s = 2.0;
-  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 1e6), env, settings);
-  Surface& s = world.surface(world.add_surface(d));
-  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-    if (s.rest_position(v).x() == 0.0) {
-      ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
-    }
-  }
+  SaggingSheet sagging(sheet(4.0, 3.0, 24, 18, 0.3, 3), settings);
+  TissueWorld& world = sagging.world;
+  Surface& s = sagging.s;
   VertexIndex index(s);
   Cutter cutter(s);
   Vitrector vit(s);
@@ -97,4 +107,40 @@ TEST(VertexIndex, ReportsExactlyTheVerticesInTheBoxWhileTheTissueMovesSleepsAndC
   // A snapshot restore moves every vertex (sleeping ones too) without waking anything.
   ASSERT_TRUE(WorldAccess::read_state(world, saved.data(), saved.size()));
   expect_exact(index, s, rng, "after a snapshot restore");
+}
+
+// The drift bound: with every block awake and sagging, a small query re-reads only the patches
+// whose grown box reaches it, not the whole sheet; waking moves nothing and forces no re-read;
+// a vertex placed by hand is found where it now is.
+TEST(VertexIndex, RereadsOnlyThePatchesTheDriftBoundBringsNearTheQuery) {
+  SolverSettings settings;
+  settings.sleeping = false;  // every block moves every step
+  SaggingSheet sagging(sheet(4.0, 3.0, 48, 36, 0.0, 5), settings);
+  TissueWorld& world = sagging.world;
+  Surface& s = sagging.s;
+  VertexIndex index(s);
+  for (int step = 0; step < 3; ++step) ASSERT_TRUE(world.step(1e-3).ok);
+  EXPECT_GT(s.block_drift_mm(0), 0.0);
+  // A box around one vertex far from the pinned edge.
+  const std::uint32_t probe = s.vertex_slots() - 1;
+  const Vec3 lo = s.position(probe).array() - 0.05, hi = s.position(probe).array() + 0.05;
+  std::vector<std::uint32_t> got;
+  index.for_each_in_box(lo, hi, [&](std::uint32_t v) { got.push_back(v); });
+  EXPECT_EQ(got, brute_force(s, lo, hi));
+  EXPECT_GT(index.last_refits(), 0u);                          // the sheet moved: the boxes there are read again
+  EXPECT_LT(index.last_refits(), index.patches_in_use() / 4);  // but only there
+  // Waking every block moves nothing: a query elsewhere re-reads only what drifted near it.
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) s.wake_vertex(v);
+  const Vec3 lo2 = s.position(0).array() - 0.05, hi2 = s.position(0).array() + 0.05;
+  got.clear();
+  index.for_each_in_box(lo2, hi2, [&](std::uint32_t v) { got.push_back(v); });
+  EXPECT_EQ(got, brute_force(s, lo2, hi2));
+  EXPECT_LT(index.last_refits(), index.patches_in_use() / 4);
+  // A vertex placed by hand far from everything is found there, and only its block is re-read.
+  const Vec3 away(10.0, 10.0, 10.0);
+  ASSERT_TRUE(s.set_position(s.vertex_id(probe), away));
+  got.clear();
+  index.for_each_in_box(away.array() - 0.01, away.array() + 0.01, [&](std::uint32_t v) { got.push_back(v); });
+  EXPECT_EQ(got, std::vector<std::uint32_t>{probe});
+  EXPECT_LE(index.last_refits(), Surface::kSleepBlock / VertexIndex::kPatch);
 }
