@@ -55,6 +55,10 @@ Surface::Surface(const SurfaceDescription& d)
   block_quiet_steps_.assign(block_awake_.size(), 0);
   block_motion_.assign(block_awake_.size(), 0);
   block_drift_mm_.assign(block_awake_.size(), 0.0);
+  vertex_noted_.assign(vcap, 0);
+  edge_noted_.assign(ecap, 0);
+  reserve_touched(noted_vertices_, vcap);
+  reserve_touched(noted_edges_, ecap);
 
   for (std::size_t i = 0; i < nv; ++i) {
     require_finite(mesh.positions[i], "surface '" + material_.name + "': vertex position");
@@ -104,6 +108,12 @@ Surface::Surface(const SurfaceDescription& d)
   // find_edge for line springs walks triangle fans, so it does not see them; line springs are
   // kept in a separate per-vertex search only at build time, which is all they need.
 
+  // Every vertex and spring, including those without triangles; the notes the build took are
+  // covered by this.
+  for (std::uint32_t v : noted_vertices_) vertex_noted_[v] = 0;
+  for (std::uint32_t e : noted_edges_) edge_noted_[e] = 0;
+  noted_vertices_.clear();
+  noted_edges_.clear();
   for (std::uint32_t v = 0; v < vertex_slots(); ++v) update_vertex_mass(v);
   for (std::uint32_t e = 0; e < edge_slots(); ++e) update_edge_stiffness(e);
   for (std::uint32_t v = 0; v < vertex_slots(); ++v) {
@@ -236,6 +246,7 @@ void Surface::link_corner(std::uint32_t t, std::uint32_t k) {
   const std::uint32_t c = 3 * t + k, v = tri_v_[t][k];
   next_corner_[c] = first_corner_[v];
   first_corner_[v] = c;
+  note_vertex(v);
 }
 
 void Surface::unlink_corner(std::uint32_t t, std::uint32_t k) {
@@ -244,9 +255,11 @@ void Surface::unlink_corner(std::uint32_t t, std::uint32_t k) {
   while (*link != kNone && *link != c) link = &next_corner_[*link];
   if (*link == c) *link = next_corner_[c];
   next_corner_[c] = kNone;
+  note_vertex(v);
 }
 
 void Surface::attach_triangle_to_edge(std::uint32_t e, std::uint32_t t) {
+  note_edge(e);
   if (edge_t_[e][0] == kNone) {
     edge_t_[e][0] = t;
   } else {
@@ -256,6 +269,7 @@ void Surface::attach_triangle_to_edge(std::uint32_t e, std::uint32_t t) {
 
 void Surface::detach_triangle_from_edge(std::uint32_t e, std::uint32_t t) {
   if (e == kNone) return;
+  note_edge(e);
   auto& et = edge_t_[e];
   if (et[0] == t) {
     et[0] = et[1];
@@ -279,6 +293,28 @@ std::uint32_t Surface::find_edge(std::uint32_t a, std::uint32_t b) const {
 }
 
 // ---- Derived quantities ---------------------------------------------------------------------
+
+void Surface::note_triangle_area(std::uint32_t t) {
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    note_vertex(tri_v_[t][k]);
+    note_edge(tri_e_[t][k]);
+  }
+}
+
+void Surface::refresh_noted() {
+  for (const std::uint32_t e : noted_edges_) {
+    edge_noted_[e] = 0;
+    update_edge_stiffness(e);  // nothing for a spring removed since
+  }
+  for (const std::uint32_t v : noted_vertices_) {
+    vertex_noted_[v] = 0;
+    if (!vertex_alive_[v]) continue;
+    update_vertex_mass(v);
+    wake_vertex(v);
+  }
+  noted_edges_.clear();
+  noted_vertices_.clear();
+}
 
 void Surface::refresh_rest(std::uint32_t e) {
   rest_vec_[e] = base_rest_vec_[e] * (surface_traction_ * edge_traction_[e]);
@@ -477,6 +513,7 @@ Surface::TearResult Surface::tear_edge(EdgeId id) {
     return result;
   }
 
+  const EditBatch edit(*this);
   const auto [a, b] = edge_v_[e];
   const Vec3 r_ab = base_rest_vec_[e];
   const double traction = edge_traction_[e];
@@ -551,19 +588,6 @@ Surface::TearResult Surface::tear_edge(EdgeId id) {
   // An opposite vertex that was already on a boundary would now join two separate fans (a
   // "bow-tie"); give each fan its own vertex so the surface stays manifold.
   for (int i = 0; i < ntri; ++i) separate_fans(sides[static_cast<std::size_t>(i)].opposite);
-
-  // Local mass and stiffness refresh: every vertex and spring whose adjacent area changed.
-  auto refresh_around = [&](std::uint32_t v) {
-    update_vertex_mass(v);
-    for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
-      for (std::uint32_t k = 0; k < 3; ++k) {
-        update_edge_stiffness(tri_e_[t][k]);
-        update_vertex_mass(tri_v_[t][k]);
-      }
-    });
-  };
-  refresh_around(ma);
-  refresh_around(mb);
 
   result.vertex_a_side = ma;
   result.vertex_b_side = mb;
@@ -644,14 +668,9 @@ std::uint32_t Surface::separate_fans(std::uint32_t v, std::vector<std::uint32_t>
         if (edge_v_[e][1] == v) edge_v_[e][1] = nv;
       }
     }
-    update_vertex_mass(nv);
-    wake_vertex(nv);
   }
-  update_vertex_mass(v);
-  wake_vertex(v);
-  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
-    for (auto e : tri_e_[t]) update_edge_stiffness(e);
-  });
+  // v's and the copies' masses are noted (their corners moved); the springs' triangles and
+  // areas are unchanged, and so are their stiffnesses.
   return copies;
 }
 

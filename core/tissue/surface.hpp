@@ -277,6 +277,29 @@ class Surface {
   // (while the list has capacity: nothing allocates), so the topology layer can tidy there.
   void apply_plasticity(double dt_s, double floor_mm = 0.0, std::vector<std::uint32_t>* crept_short = nullptr);
 
+  // ---- Batched edits --------------------------------------------------------------------------
+  // Vertex mass and spring stiffness are computed from the rest areas of the adjacent triangles.
+  // Every topology edit notes the vertices and springs whose triangles it changed and recomputes
+  // each of them, once, when it ends. While an EditBatch is open the notes collect instead, and
+  // each noted vertex and spring is recomputed once when the outermost batch closes: a blade
+  // stroke makes dozens of splits whose fans overlap, and recomputing after each would redo most
+  // of them several times. Inside a batch the masses, inverse masses and stiffnesses around the
+  // edits are stale (topology, rest vectors, rest areas and positions are always current); an edit
+  // that reads masses (collapse_edge) brings them up to date first. The result is the same, bit for
+  // bit, as making the edits one at a time: each value depends only on the final mesh.
+  class EditBatch {
+   public:
+    explicit EditBatch(Surface& surface) : surface_(surface) { ++surface_.open_batches_; }
+    ~EditBatch() {
+      if (--surface_.open_batches_ == 0) surface_.refresh_noted();
+    }
+    EditBatch(const EditBatch&) = delete;
+    EditBatch& operator=(const EditBatch&) = delete;
+
+   private:
+    Surface& surface_;
+  };
+
   // Recomputes mass and inverse mass of vertex v from its adjacent rest area.
   void update_vertex_mass(std::uint32_t v);
   // Recomputes the stiffness of triangle edge e from its adjacent rest areas (line springs keep theirs).
@@ -298,7 +321,21 @@ class Surface {
   void refresh_rest(std::uint32_t e);
   std::uint32_t separate_fans(std::uint32_t v, std::vector<std::uint32_t>* copies = nullptr);
   void free_vertex(std::uint32_t v);
-  void refresh_around(std::uint32_t v);
+  // Notes for the batched recomputation (see EditBatch): v's triangles changed; e's triangles
+  // or rest vector changed; t's rest area changed (its corners and springs).
+  void note_vertex(std::uint32_t v) {
+    if (vertex_noted_[v]) return;
+    vertex_noted_[v] = 1;
+    noted_vertices_.push_back(v);
+  }
+  void note_edge(std::uint32_t e) {
+    if (edge_noted_[e]) return;
+    edge_noted_[e] = 1;
+    noted_edges_.push_back(e);
+  }
+  void note_triangle_area(std::uint32_t t);
+  // Recomputes every noted spring's stiffness and vertex's mass (waking the vertex), and clears the notes.
+  void refresh_noted();
   // The spring's rest vector oriented from vertex `from` (which must be one of its ends).
   Vec3 oriented_rest(std::uint32_t e, std::uint32_t from) const {
     return edge_v_[e][0] == from ? base_rest_vec_[e] : Vec3(-base_rest_vec_[e]);
@@ -339,6 +376,11 @@ class Surface {
   std::vector<double> block_drift_mm_;       // see block_drift_mm()
   std::uint64_t topology_version_ = 0;
   std::uint32_t line_springs_ = 0;
+
+  // Batched edits (see EditBatch): flags and lists of the noted vertices and springs.
+  std::vector<std::uint8_t> vertex_noted_, edge_noted_;
+  std::vector<std::uint32_t> noted_vertices_, noted_edges_;
+  std::uint32_t open_batches_ = 0;
 };
 
 // Raw arrays handed to the solver (no copies). Valid until the next topology change.

@@ -16,45 +16,6 @@ bool Surface::has_room(std::uint32_t vertices, std::uint32_t edges, std::uint32_
          room(triangle_slots(), tri_v_.capacity(), free_triangles_.size()) >= triangles;
 }
 
-void Surface::refresh_around(std::uint32_t v) {
-  // Each vertex and spring of v's triangles once (a fan repeats v and shares springs): the masses
-  // and stiffnesses only depend on the current rest areas, so updating each once is enough.
-  std::array<std::uint32_t, 48> verts{}, edges{};
-  std::size_t nv = 0, ne = 0;
-  auto add_once = [](std::array<std::uint32_t, 48>& list, std::size_t& n, std::uint32_t x) {
-    for (std::size_t i = 0; i < n; ++i) {
-      if (list[i] == x) return true;
-    }
-    if (n == list.size()) return false;
-    list[n++] = x;
-    return true;
-  };
-  bool fits = add_once(verts, nv, v);
-  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      fits = add_once(verts, nv, tri_v_[t][k]) && fits;
-      fits = add_once(edges, ne, tri_e_[t][k]) && fits;
-    }
-  });
-  if (!fits) {  // a fan too large for the lists: every vertex and spring, repeats and all
-    update_vertex_mass(v);
-    wake_vertex(v);
-    for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
-      for (std::uint32_t k = 0; k < 3; ++k) {
-        update_edge_stiffness(tri_e_[t][k]);
-        update_vertex_mass(tri_v_[t][k]);
-        wake_vertex(tri_v_[t][k]);
-      }
-    });
-    return;
-  }
-  for (std::size_t i = 0; i < ne; ++i) update_edge_stiffness(edges[i]);
-  for (std::size_t i = 0; i < nv; ++i) {
-    update_vertex_mass(verts[i]);
-    wake_vertex(verts[i]);
-  }
-}
-
 void Surface::free_vertex(std::uint32_t v) {
   ++topology_version_;
   wake_vertex(v);
@@ -131,6 +92,7 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
       return r;
     }
   }
+  const EditBatch edit(*this);
   for (auto tri : tris) {
     if (tri != kNone) free_triangle(tri);
   }
@@ -159,11 +121,6 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
       make_triangle({b, m, s.o}, {e_mb, e_mo, s.e_bo}, (1.0 - t) * s.area);
       make_triangle({m, a, s.o}, {e_am, s.e_ao, e_mo}, t * s.area);
     }
-  }
-  refresh_around(m);  // with a triangle on the spring, a and b are in m's fan
-  if (n == 0) {        // a spring with no triangle leaves them out
-    update_vertex_mass(a);
-    update_vertex_mass(b);
   }
   r.vertex = m;
   return r;
@@ -196,6 +153,7 @@ Surface::SplitResult Surface::split_triangle(TriangleId id, const std::array<dou
     r.status = Status::error("split_triangle: the point rests on a corner (degenerate spring)");
     return r;
   }
+  const EditBatch edit(*this);
   free_triangle(t);
 
   const std::uint32_t p = allocate_vertex();
@@ -214,7 +172,6 @@ Surface::SplitResult Surface::split_triangle(TriangleId id, const std::array<dou
   make_triangle({a, b, p}, {e_ab, e_bp, e_ap}, w[2] * area);
   make_triangle({b, c, p}, {e_bc, e_cp, e_bp}, w[0] * area);
   make_triangle({c, a, p}, {e_ca, e_ap, e_cp}, w[1] * area);
-  refresh_around(p);
   r.vertex = p;
   return r;
 }
@@ -234,6 +191,7 @@ Surface::DisconnectResult Surface::disconnect_edge(EdgeId id) {
     r.status = Status::error("disconnect_edge: spring pool full (raise the surface capacity)");
     return r;
   }
+  const EditBatch edit(*this);
   const std::uint32_t t1 = edge_t_[e][1];
   const auto ev = edge_v_[e];
   const std::uint32_t copy = add_edge(ev[0], ev[1], base_rest_vec_[e], edge_traction_[e]);
@@ -242,8 +200,6 @@ Surface::DisconnectResult Surface::disconnect_edge(EdgeId id) {
     if (te == e) te = copy;
   }
   attach_triangle_to_edge(copy, t1);
-  update_edge_stiffness(e);
-  update_edge_stiffness(copy);
   wake_vertex(ev[0]);
   wake_vertex(ev[1]);
   r.copy = copy;
@@ -252,6 +208,7 @@ Surface::DisconnectResult Surface::disconnect_edge(EdgeId id) {
 
 std::uint32_t Surface::separate_vertex_fans(VertexId id, std::vector<std::uint32_t>* copies) {
   if (!is_current(id)) return 0;
+  const EditBatch edit(*this);
   return separate_fans(id.index, copies);
 }
 
@@ -273,21 +230,15 @@ Surface::RemoveResult Surface::remove_triangle(TriangleId id, bool separate) {
   // Vertex mass is density × area / 3 + extra mass, so the removed mass is exactly the triangle's
   // density × area plus the extra mass of vertices that go with it.
   r.removed_mass_g = material_.areal_density_g_per_mm2() * r.removed_area_mm2;
+  const EditBatch edit(*this);
   free_triangle(t);
   ++topology_version_;
   for (auto e : te) {
-    if (edge_t_[e][0] == kNone && !edge_is_line_[e]) {
-      free_edge(e);
-    } else {
-      update_edge_stiffness(e);
-    }
+    if (edge_t_[e][0] == kNone && !edge_is_line_[e]) free_edge(e);
   }
   for (auto v : tv) {
     wake_vertex(v);
-    if (first_corner_[v] != kNone) {
-      update_vertex_mass(v);
-      continue;
-    }
+    if (first_corner_[v] != kNone) continue;
     // No triangle left: the vertex goes, with any line springs that still hang on it.
     if (line_springs_ > 0) {
       for (std::uint32_t e = 0; e < edge_slots(); ++e) {
@@ -339,13 +290,14 @@ Status Surface::dissolve_triangle(TriangleId id, TriangleId into) {
     }
   }
   if (!has_room(3, 0, 0)) return Status::error("dissolve_triangle: vertex pool full (raise the surface capacity)");
+  const EditBatch edit(*this);
   tri_rest_area_[u] += tri_rest_area_[t];
+  note_triangle_area(u);
   const auto removed = remove_triangle(id, true);
   if (!removed.status) {  // cannot happen after the checks above; undo the transfer regardless
     tri_rest_area_[u] -= tri_rest_area_[t];
     return removed.status;
   }
-  for (auto v : tri_v_[u]) refresh_around(v);
   return Status::ok();
 }
 
@@ -498,13 +450,17 @@ Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, doubl
   }
 
   // ---- Apply (nothing below can fail) ----
+  const EditBatch edit(*this);
+  refresh_noted();  // the momentum below needs current masses, also inside a caller's batch
   ++topology_version_;
   const double m_k = mass_[k], m_r = mass_[r];
   if (m_k + m_r > 0.0) v_[k] = (m_k * v_[k] + m_r * v_[r]) / (m_k + m_r);
   extra_mass_[k] += extra_mass_[r];
+  note_vertex(k);
   for (std::uint32_t i = 0; i < nwings; ++i) {
     const Wing& w = wings[i];
     tri_rest_area_[w.receiver] += tri_rest_area_[w.t];
+    note_triangle_area(w.receiver);
     free_triangle(w.t);
     ++res.triangles_removed;
   }
@@ -536,10 +492,12 @@ Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, doubl
         fv[0] = k;
         base_rest_vec_[f] = r_kr + base_rest_vec_[f];
         refresh_rest(f);
+        note_edge(f);
       } else if (fv[1] == r) {
         fv[1] = k;
         base_rest_vec_[f] = base_rest_vec_[f] - r_kr;
         refresh_rest(f);
+        note_edge(f);
       }
     }
   }
@@ -551,19 +509,17 @@ Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, doubl
         fv[0] = k;
         base_rest_vec_[f] = r_kr + base_rest_vec_[f];
         refresh_rest(f);
+        note_edge(f);
       } else if (fv[1] == r) {
         fv[1] = k;
         base_rest_vec_[f] = base_rest_vec_[f] - r_kr;
         refresh_rest(f);
+        note_edge(f);
       }
     }
   }
   first_corner_[r] = kNone;
   free_vertex(r);
-  refresh_around(k);
-  for (std::uint32_t i = 0; i < nwings; ++i) {
-    for (auto v : tri_v_[wings[i].receiver]) refresh_around(v);
-  }
   if (pinch) separate_fans(k);
   res.removed_vertex = r;
   return res;

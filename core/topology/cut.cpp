@@ -31,6 +31,8 @@ Cutter::Cutter(Surface& surface, CutSettings settings)
   near_rim_.assign(nv, 0);
   rim_mask_.assign(nv, 0);
   separated_.assign(nv, 0);
+  side_.assign(nv, {0.0, 0.0});
+  side_stamp_.assign(nv, 0);
   edge_stamp_.assign(ne, 0);
   triangle_stamp_.assign(nt, 0);
   // Scratch sized for the worst case and touched now, so no stroke allocates or takes a page fault.
@@ -66,6 +68,38 @@ bool Cutter::near_swept(const Vec3& p, double tolerance) const {
   return false;
 }
 
+std::array<double, 2> Cutter::plane_distances(const Vec3& x) const {
+  std::array<double, 2> d{};
+  for (std::size_t k = 0; k < 2; ++k) d[k] = swept_valid_[k] ? swept_normal_[k].dot(x - swept_[k][0]) : 0.0;
+  return d;
+}
+
+const std::array<double, 2>& Cutter::side(std::uint32_t v) {
+  if (side_stamp_[v] != stamp_) {
+    side_stamp_[v] = stamp_;
+    side_[v] = plane_distances(surface_.position(v));
+  }
+  return side_[v];
+}
+
+// Inline: called for every spring around the cut, and the swept planes stay in registers.
+inline bool Cutter::crosses(std::uint32_t e, double& t) {
+  const auto [a, b] = surface_.edge_vertices(e);
+  const std::array<double, 2> da = side(a), db = side(b);
+  for (std::size_t k = 0; k < 2; ++k) {
+    // A spring crosses plane k where its ends' signed distances differ in sign (an invalid
+    // triangle has distance 0 everywhere, so never).
+    if (!(da[k] * db[k] < 0.0)) continue;
+    const Vec3 &xa = surface_.position(a), &xb = surface_.position(b);
+    t = da[k] / (da[k] - db[k]);
+    const Vec3 x = xa + t * (xb - xa);
+    const Vec3 c = closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2]);
+    const double band = settings_.band_mm;
+    if ((x - c).squaredNorm() <= band * band + 1e-24) return true;
+  }
+  return false;
+}
+
 void Cutter::mark(std::uint32_t v) {
   if (cut_stamp_[v] == stamp_) return;
   cut_stamp_[v] = stamp_;
@@ -78,11 +112,12 @@ void Cutter::gather_candidates() {
   const double band = settings_.band_mm;
   const auto wanted = [&](std::uint32_t v) {
     const Vec3& x = s.position(v);
+    const std::array<double, 2> d = plane_distances(x);
     // near_swept(x, margin) and near_swept(x, band) at once, each exact distance at most once.
     bool candidate = false, on_surface = false;
     for (std::size_t k = 0; k < 2; ++k) {
       if (!swept_valid_[k]) continue;
-      const double plane = std::abs(swept_normal_[k].dot(x - swept_[k][0]));
+      const double plane = std::abs(d[k]);
       if (plane > margin_mm_ || (candidate && (on_surface || plane > band))) continue;
       const double d2 = (x - closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2])).squaredNorm();
       candidate = candidate || d2 <= margin_mm_ * margin_mm_;
@@ -90,6 +125,8 @@ void Cutter::gather_candidates() {
     }
     if (!candidate) return;
     candidates_.push_back(v);
+    side_stamp_[v] = stamp_;  // for the crossing tests of the springs around it
+    side_[v] = d;
     if (on_surface) mark(v);  // the vertex and grazing cases
     std::uint8_t mask = 0;
     for (std::size_t k = 0; k < rim_.size(); ++k) {
@@ -164,7 +201,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     r.status = Status::error("cut: degenerate sweep (the blade did not sweep any area)");
     return r;
   }
-  const double band = settings_.band_mm, snap = settings_.snap_fraction;
+  const double band = settings_.band_mm;
   box_lo_ = p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1).array() - margin_mm_;
   box_hi_ = p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1).array() + margin_mm_;
 
@@ -176,15 +213,13 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
 
   // Ends: the quad's boundary passing through the surface.
   const auto& boundary = rim_;
-  std::array<Vec3, 32> ends{};
-  std::array<TriangleId, 32> end_triangle{};  // where each end was found
-  std::uint32_t nends = 0;
+  Ends ends;
   auto add_end = [&](const Vec3& y, std::uint32_t t) {
     bool known = false;
-    for (std::uint32_t i = 0; i < nends; ++i) known = known || (ends[i] - y).norm() <= std::max(band, 1e-9);
-    if (!known && nends < ends.size()) {
-      end_triangle[nends] = s.triangle_id(t);
-      ends[nends++] = y;
+    for (std::uint32_t i = 0; i < ends.count; ++i) known = known || (ends.at[i] - y).norm() <= std::max(band, 1e-9);
+    if (!known && ends.count < ends.at.size()) {
+      ends.triangle[ends.count] = s.triangle_id(t);
+      ends.at[ends.count++] = y;
     }
   };
   auto rim_bits = [&](std::uint32_t v) { return near_rim_[v] == stamp_ ? rim_mask_[v] : std::uint8_t{0}; };
@@ -218,40 +253,43 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
 
   // Crossings of the springs found so far (inserting the ends below only adds springs around the
   // new end vertices; the others keep their crossings, as nothing moves).
-  auto crossing = [&](std::uint32_t e, double& t) {
-    const auto [a, b] = s.edge_vertices(e);
-    const Vec3 &xa = s.position(a), &xb = s.position(b);
-    for (std::size_t k = 0; k < 2; ++k) {
-      if (!swept_valid_[k]) continue;
-      const double da = swept_normal_[k].dot(xa - swept_[k][0]);
-      const double db = swept_normal_[k].dot(xb - swept_[k][0]);
-      if (!(da * db < 0.0)) continue;
-      t = da / (da - db);
-      const Vec3 x = xa + t * (xb - xa);
-      const Vec3 c = closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2]);
-      if ((x - c).squaredNorm() <= band * band + 1e-24) return true;
-    }
-    return false;
-  };
   crossings_.clear();
   for (auto e : edges_) {
     double t;
-    if (crossing(e, t)) crossings_.push_back({s.edge_id(e), t});
+    if (crosses(e, t)) crossings_.push_back({s.edge_id(e), t});
   }
   const auto ncross = static_cast<std::uint32_t>(crossings_.size());
-  const std::uint32_t k = nends + ncross + static_cast<std::uint32_t>(on_cut_.size()) + 2;
+  const std::uint32_t k = ends.count + ncross + static_cast<std::uint32_t>(on_cut_.size()) + 2;
   if (!s.has_room(3 * k, 6 * k, 3 * k)) {
     r.status = Status::error("cut: pools full (raise the surface capacity)");
     return r;
   }
-  if (nends == 0 && ncross == 0 && on_cut_.empty()) return r;  // the blade missed the tissue
+  if (ends.count == 0 && ncross == 0 && on_cut_.empty()) return r;  // the blade missed the tissue
+  insert_cut(r, ends);
+  for (auto v : on_cut_) {
+    if (s.vertex_alive(v)) s.wake_vertex(v);
+  }
+  // Every triangle the cut made or changed has a vertex on the cut (or a copy of one).
+  const QualityResult q = quality_.clean_around(on_cut_);
+  r.collapsed = q.collapses;
+  r.unresolved = q.unresolved;
+  r.removed_mass_g = q.removed_mass_g;
+  return r;
+}
 
+// Steps 1–3 of the header: the ends, the crossings and the opening, as one batch of edits
+// (Surface::EditBatch: the masses and stiffnesses around the cut are recomputed once, at its end).
+void Cutter::insert_cut(CutResult& r, const Ends& ends) {
+  Surface& s = surface_;
+  const Surface::EditBatch batch(s);
+  const double band = settings_.band_mm, snap = settings_.snap_fraction;
   // 1. Insert the ends.
   std::array<std::uint32_t, 32> created{};  // end vertices made by splitting
   std::array<std::uint32_t, 32> end_vertices{};  // those and the ones snapped onto
   std::uint32_t ncreated = 0, nend_vertices = 0;
-  for (std::uint32_t i = 0; i < nends; ++i) {
-    const Vec3& y = ends[i];
+  const auto& end_triangle = ends.triangle;
+  for (std::uint32_t i = 0; i < ends.count; ++i) {
+    const Vec3& y = ends.at[i];
     std::uint32_t best = kNone;
     double best_d2 = 1e-12;
     // Usually the triangle it was found in is still there; otherwise (an earlier end split it)
@@ -348,7 +386,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
         const auto [a, b] = s.edge_vertices(e);
         if (!is_created(a) && !is_created(b) && seen_before) continue;  // in the first search
         double t;
-        if (crossing(e, t) && crossings_.size() < crossings_.capacity()) crossings_.push_back({s.edge_id(e), t});
+        if (crosses(e, t) && crossings_.size() < crossings_.capacity()) crossings_.push_back({s.edge_id(e), t});
       }
     });
   }
@@ -437,19 +475,14 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     for (auto v : s.edge_vertices(id.index)) {
       if (!s.vertex_alive(v) || separated_[v] == stamp_) continue;  // once per vertex
       separated_[v] = stamp_;
+      const std::size_t before = on_cut_.size();
       r.vertices_added += s.separate_vertex_fans(s.vertex_id(v), &on_cut_);  // copies join the cut
+      // A copy takes one fan whole: there is nothing to separate at it (the opened springs now
+      // name it, so without this each would be visited again).
+      for (std::size_t i = before; i < on_cut_.size(); ++i) separated_[on_cut_[i]] = stamp_;
     }
   }
   r.vertices_added += r.end_points + r.springs_split;
-  for (auto v : on_cut_) {
-    if (s.vertex_alive(v)) s.wake_vertex(v);
-  }
-  // Every triangle the cut made or changed has a vertex on the cut (or a copy of one).
-  const QualityResult q = quality_.clean_around(on_cut_);
-  r.collapsed = q.collapses;
-  r.unresolved = q.unresolved;
-  r.removed_mass_g = q.removed_mass_g;
-  return r;
 }
 
 }  // namespace vitreo::core

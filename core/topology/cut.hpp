@@ -91,7 +91,20 @@ class Cutter {
   Surface& surface() { return surface_; }
 
  private:
+  // Where the quad's boundary passes through the surface (step 1), and the triangle it was found in.
+  struct Ends {
+    std::array<Vec3, 32> at{};
+    std::array<TriangleId, 32> triangle{};
+    std::uint32_t count = 0;
+  };
   bool near_swept(const Vec3& p, double tolerance) const;
+  // Signed distances of x to the planes of the two swept triangles (0 for a degenerate one).
+  std::array<double, 2> plane_distances(const Vec3& x) const;
+  // The same for vertex v, computed once per stroke (the springs around a vertex share it).
+  const std::array<double, 2>& side(std::uint32_t v);
+  // Whether spring e crosses the swept surface (within the band), and where (t from its first end).
+  bool crosses(std::uint32_t e, double& t);
+  void insert_cut(CutResult& r, const Ends& ends);
   void gather_candidates();
   void gather_edges();
   void mark(std::uint32_t v);
@@ -119,7 +132,9 @@ class Cutter {
   std::vector<EdgeId> to_open_;
   std::vector<std::uint8_t> cut_degree_;
   std::vector<std::uint32_t> near_rim_, separated_;  // == stamp_: within the margin of the quad's boundary
-  std::vector<std::uint8_t> rim_mask_;  // where near_rim_ == stamp_: bit k, within the margin of rim_[k]
+  std::vector<std::uint8_t> rim_mask_;
+  std::vector<std::array<double, 2>> side_;  // plane_distances of vertex v, where side_stamp_[v] == stamp_
+  std::vector<std::uint32_t> side_stamp_;  // where near_rim_ == stamp_: bit k, within the margin of rim_[k]
 };
 
 }  // namespace vitreo::core
