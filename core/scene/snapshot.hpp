@@ -19,7 +19,7 @@
 
 namespace vitreo::core {
 
-inline constexpr std::uint32_t kSnapshotVersion = 2;  // 2: the solver's wake lengths
+inline constexpr std::uint32_t kSnapshotVersion = 3;  // 2: the solver's wake lengths; 3: sleep groups are derived, not stored
 
 struct SnapshotInfo {
   std::uint32_t version = 0;

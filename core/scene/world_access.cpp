@@ -257,13 +257,6 @@ void WorldAccess::write_state(const TissueWorld& w, std::vector<std::uint8_t>& o
     o.vec(sc.block_sleep_serial);
     o.vec(sc.wake_key);
     o.vec(sc.wake_length);
-    o.vec(sc.group_begin);
-    o.vec(sc.group_edges);
-    o.vec(sc.partner_begin);
-    o.vec(sc.partners);
-    o.vec(sc.mark);
-    o.vec(sc.group_active);
-    o.pod(sc.groups_version);
     o.vec(sc.lambda_distance);
     o.vec(sc.lambda_direction);
   }
@@ -399,7 +392,10 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       in.fixed_vec(f.block_awake_);
       in.fixed_vec(f.block_quiet_steps_);
       in.pod(f.topology_version_);
-      if (apply) f.note_all_blocks_moved();  // positions replaced: spatial indexes refit everything
+      if (apply) {
+        f.note_all_blocks_moved();  // positions replaced: spatial indexes refit everything
+        f.forget_spring_log();      // springs replaced: derived groups rebuild from every spring
+      }
 
       auto& sc = w.scratch_[i];
       in.fixed_vec(sc.previous);
@@ -417,13 +413,6 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       in.fixed_vec(sc.block_sleep_serial);
       in.fixed_vec(sc.wake_key);
       in.fixed_vec(sc.wake_length);
-      in.fixed_vec(sc.group_begin);
-      in.fixed_vec(sc.group_edges);
-      in.fixed_vec(sc.partner_begin);
-      in.fixed_vec(sc.partners);
-      in.fixed_vec(sc.mark);
-      in.fixed_vec(sc.group_active);
-      in.pod(sc.groups_version);
       in.fixed_vec(sc.lambda_distance);
       in.fixed_vec(sc.lambda_direction);
     }

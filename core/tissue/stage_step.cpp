@@ -108,51 +108,7 @@ bool TissueWorld::update_velocities(double h) {
 }
 
 void TissueWorld::prepare_sleep_groups() {
-  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
-    const Surface& s = *surfaces_[si];
-    Scratch& sc = scratch_[si];
-    const std::uint32_t blocks = s.block_count();
-    if (sc.groups_version != s.topology_version()) {
-      // Counting sort of live springs by the block of their lower vertex (mesh order inside).
-      std::fill(sc.group_begin.begin(), sc.group_begin.end(), 0u);
-      for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
-        if (!s.edge_alive(e)) continue;
-        const auto ev = s.edge_vertices(e);
-        ++sc.group_begin[std::min(ev[0], ev[1]) / Surface::kSleepBlock + 1];
-      }
-      for (std::uint32_t g = 0; g < blocks; ++g) sc.group_begin[g + 1] += sc.group_begin[g];
-      // Fill using partner_begin as a temporary cursor.
-      std::copy(sc.group_begin.begin(), sc.group_begin.end(), sc.partner_begin.begin());
-      for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
-        if (!s.edge_alive(e)) continue;
-        const auto ev = s.edge_vertices(e);
-        sc.group_edges[sc.partner_begin[std::min(ev[0], ev[1]) / Surface::kSleepBlock]++] = e;
-      }
-      // The other blocks each group reaches, without duplicates.
-      std::fill(sc.mark.begin(), sc.mark.end(), 0u);
-      std::uint32_t n = 0;
-      for (std::uint32_t g = 0; g < blocks; ++g) {
-        sc.partner_begin[g] = n;
-        for (std::uint32_t i = sc.group_begin[g]; i < sc.group_begin[g + 1]; ++i) {
-          const auto ev = s.edge_vertices(sc.group_edges[i]);
-          const std::uint32_t other = std::max(ev[0], ev[1]) / Surface::kSleepBlock;
-          if (other != g && sc.mark[other] != g + 1 && n < sc.partners.size()) {
-            sc.mark[other] = g + 1;
-            sc.partners[n++] = other;
-          }
-        }
-      }
-      sc.partner_begin[blocks] = n;
-      sc.groups_version = s.topology_version();
-    }
-    for (std::uint32_t g = 0; g < blocks; ++g) {
-      bool active = s.block_awake(g);
-      for (std::uint32_t i = sc.partner_begin[g]; i < sc.partner_begin[g + 1] && !active; ++i) {
-        active = s.block_awake(sc.partners[i]);
-      }
-      sc.group_active[g] = active ? 1 : 0;
-    }
-  }
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) scratch_[si].groups.update(*surfaces_[si]);
 }
 
 void TissueWorld::finish_sleep() {

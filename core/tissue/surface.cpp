@@ -207,6 +207,7 @@ void Surface::free_edge(std::uint32_t e) {
   wake_vertex(edge_v_[e][0]);
   wake_vertex(edge_v_[e][1]);
   edge_alive_[e] = 0;
+  log_spring(e);
   stiffness_[e] = 0.0;
   ++edge_generation_[e];
   free_edges_.push_back(e);
@@ -227,6 +228,7 @@ void Surface::free_triangle(std::uint32_t t) {
 std::uint32_t Surface::add_edge(std::uint32_t a, std::uint32_t b, const Vec3& base_rest_vector, double traction) {
   const std::uint32_t e = allocate_edge();
   edge_v_[e] = {a, b};
+  log_spring(e);
   base_rest_vec_[e] = base_rest_vector;
   edge_traction_[e] = traction;
   refresh_rest(e);
@@ -595,53 +597,54 @@ Surface::TearResult Surface::tear_edge(EdgeId id) {
 }
 
 std::uint32_t Surface::separate_fans(std::uint32_t v, std::vector<std::uint32_t>* out) {
-  // Collect v's triangles and group them into fans connected through edges incident to v.
-  std::array<std::uint32_t, 64> tris{};
-  std::array<std::uint8_t, 64> group{};
+  // v's triangles, with the corner v sits at (its two springs at v are tri_e_[t][corner] and
+  // tri_e_[t][corner + 2], so no spring needs reading to find them).
+  constexpr std::size_t kMax = 64;
+  std::array<std::uint32_t, kMax> tris;
+  std::array<std::uint8_t, kMax> corner, fan, stack;
   std::size_t n = 0;
   bool overflow = false;
-  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
-    if (n < tris.size()) {
-      tris[n++] = t;
-    } else {
+  for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t c) {
+    if (n == kMax) {
       overflow = true;
+      return;
     }
+    tris[n] = t;
+    corner[n++] = static_cast<std::uint8_t>(c);
   });
   if (n < 2 || overflow) return 0;
-  // Triangles joined through a spring at v belong to one fan: join each triangle to the other
-  // triangle of its two springs through v (edge_t_ knows it), with a small union–find over the
-  // fan's positions. Fans are numbered by their first triangle in the corner list, so the fan of
-  // the first triangle keeps v and the others get copies in a fixed order.
-  std::array<std::uint8_t, 64> parent{};
-  for (std::size_t i = 0; i < n; ++i) parent[i] = static_cast<std::uint8_t>(i);
-  auto root = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  // Fans: triangles joined through a spring at v (edge_t_ names its other triangle), found by a
+  // flood from each triangle not yet reached, in corner-list order. So fans are numbered by their
+  // first triangle in the corner list: the first keeps v, the others get copies in a fixed order.
+  std::fill_n(fan.begin(), n, std::uint8_t{0});
+  std::uint8_t fans = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    for (const std::uint32_t e : tri_e_[tris[i]]) {
-      if (e == kNone || (edge_v_[e][0] != v && edge_v_[e][1] != v)) continue;
-      const std::uint32_t other = edge_t_[e][0] == tris[i] ? edge_t_[e][1] : edge_t_[e][0];
-      if (other == kNone) continue;
-      for (std::size_t j = 0; j < n; ++j) {
-        if (tris[j] != other) continue;
-        const std::size_t ri = root(i), rj = root(j);
-        if (ri != rj) parent[std::max(ri, rj)] = static_cast<std::uint8_t>(std::min(ri, rj));
-        break;
+    if (fan[i] != 0) continue;
+    fan[i] = ++fans;
+    std::size_t top = 0;
+    stack[top++] = static_cast<std::uint8_t>(i);
+    while (top > 0) {
+      const std::size_t x = stack[--top];
+      const auto& te = tri_e_[tris[x]];
+      for (const std::uint32_t e : {te[corner[x]], te[(corner[x] + 2u) % 3u]}) {
+        if (e == kNone) continue;
+        const std::uint32_t other = edge_t_[e][0] == tris[x] ? edge_t_[e][1] : edge_t_[e][0];
+        if (other == kNone) continue;
+        for (std::size_t j = 0; j < n; ++j) {
+          if (tris[j] != other) continue;
+          if (fan[j] == 0) {
+            fan[j] = fans;
+            stack[top++] = static_cast<std::uint8_t>(j);
+          }
+          break;
+        }
       }
     }
   }
-  group.fill(0);
-  std::uint8_t groups = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t r = root(i);
-    if (r == i) group[i] = ++groups;  // the smallest position of a fan is its root: seen first
-    else group[i] = group[r];
-  }
-  if (groups < 2) return 0;
+  if (fans < 2) return 0;
   std::uint32_t copies = 0;
   // Every fan after the first moves to a new copy of v.
-  for (std::uint8_t g = 2; g <= groups; ++g) {
+  for (std::uint8_t g = 2; g <= fans; ++g) {
     if (free_vertices_.empty() && vertex_slots() >= x_.capacity()) break;  // pool full: leave as is
     ++copies;
     const std::uint32_t nv = allocate_vertex();
@@ -651,21 +654,19 @@ std::uint32_t Surface::separate_fans(std::uint32_t v, std::vector<std::uint32_t>
     rest_[nv] = rest_[v];
     fixed_[nv] = fixed_[v];
     for (std::size_t i = 0; i < n; ++i) {
-      if (group[i] != g) continue;
-      const std::uint32_t t = tris[i];
-      for (std::uint32_t k = 0; k < 3; ++k) {
-        if (tri_v_[t][k] != v) continue;
-        unlink_corner(t, k);
-        tri_v_[t][k] = nv;
-        link_corner(t, k);
-      }
-      // The two edges of t through v: re-home them onto nv (an edge shared with a triangle of
-      // another fan cannot exist, or the fans would be connected).
-      for (std::uint32_t k = 0; k < 3; ++k) {
-        const std::uint32_t e = tri_e_[t][k];
+      if (fan[i] != g) continue;
+      const std::uint32_t t = tris[i], k = corner[i];
+      unlink_corner(t, k);
+      tri_v_[t][k] = nv;
+      link_corner(t, k);
+      // Its two springs at v move to nv (a spring shared with a triangle of another fan cannot
+      // exist, or the fans would be joined).
+      for (const std::uint32_t e : {tri_e_[t][k], tri_e_[t][(k + 2u) % 3u]}) {
         if (e == kNone) continue;
-        if (edge_v_[e][0] == v) edge_v_[e][0] = nv;
-        if (edge_v_[e][1] == v) edge_v_[e][1] = nv;
+        auto& ev = edge_v_[e];
+        if (ev[0] != v && ev[1] != v) continue;  // moved already, with the fan's other triangle
+        (ev[0] == v ? ev[0] : ev[1]) = nv;
+        log_spring(e);
       }
     }
   }

@@ -266,6 +266,23 @@ class Surface {
   // Incremented by every topology change, so solver-side indexes know when to rebuild.
   std::uint64_t topology_version() const { return topology_version_; }
 
+  // ---- Spring log ------------------------------------------------------------------------------
+  // Every spring added, removed or moved to another vertex is logged by its slot (a slot may
+  // appear several times), so a structure derived from the springs — the solver's sleep groups —
+  // can follow a topology change by looking at those slots instead of every spring. The log is a
+  // ring of kSpringLogSize entries under a position that only grows: a reader remembers the
+  // position it has read to (spring_log_end()) and reads the entries from there; where it has
+  // fallen more than the ring behind, or the surface's springs were replaced wholesale (a restored
+  // snapshot: forget_spring_log), spring_log_lost says so and the reader rebuilds from every spring.
+  // Not part of the state.
+  static constexpr std::uint32_t kSpringLogSize = 8192;
+  std::uint64_t spring_log_end() const { return spring_log_end_; }
+  bool spring_log_lost(std::uint64_t from) const {
+    return from < spring_log_kept_from_ || spring_log_end_ - from > kSpringLogSize;
+  }
+  std::uint32_t spring_log_at(std::uint64_t position) const { return spring_log_[position % kSpringLogSize]; }
+  void forget_spring_log() { spring_log_kept_from_ = ++spring_log_end_; }  // every reader's position is lost
+
   // ---- Solver access -------------------------------------------------------------------------
   // The solver works on the raw arrays; these are for it and for the topology code only.
   struct SolverView;
@@ -334,6 +351,7 @@ class Surface {
     noted_edges_.push_back(e);
   }
   void note_triangle_area(std::uint32_t t);
+  void log_spring(std::uint32_t e) { spring_log_[spring_log_end_++ % kSpringLogSize] = e; }
   // Recomputes every noted spring's stiffness and vertex's mass (waking the vertex), and clears the notes.
   void refresh_noted();
   // The spring's rest vector oriented from vertex `from` (which must be one of its ends).
@@ -381,6 +399,11 @@ class Surface {
   std::vector<std::uint8_t> vertex_noted_, edge_noted_;
   std::vector<std::uint32_t> noted_vertices_, noted_edges_;
   std::uint32_t open_batches_ = 0;
+
+  // The spring log (see spring_log_end): a ring, the position after its last entry, and the
+  // first position that is still valid (entries before it describe springs since replaced).
+  std::vector<std::uint32_t> spring_log_ = std::vector<std::uint32_t>(kSpringLogSize, 0);
+  std::uint64_t spring_log_end_ = 0, spring_log_kept_from_ = 0;
 };
 
 // Raw arrays handed to the solver (no copies). Valid until the next topology change.

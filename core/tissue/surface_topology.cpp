@@ -490,11 +490,13 @@ Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, doubl
       auto& fv = edge_v_[f];
       if (fv[0] == r) {
         fv[0] = k;
+        log_spring(f);
         base_rest_vec_[f] = r_kr + base_rest_vec_[f];
         refresh_rest(f);
         note_edge(f);
       } else if (fv[1] == r) {
         fv[1] = k;
+        log_spring(f);
         base_rest_vec_[f] = base_rest_vec_[f] - r_kr;
         refresh_rest(f);
         note_edge(f);
@@ -507,11 +509,13 @@ Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, doubl
       auto& fv = edge_v_[f];
       if (fv[0] == r) {
         fv[0] = k;
+        log_spring(f);
         base_rest_vec_[f] = r_kr + base_rest_vec_[f];
         refresh_rest(f);
         note_edge(f);
       } else if (fv[1] == r) {
         fv[1] = k;
+        log_spring(f);
         base_rest_vec_[f] = base_rest_vec_[f] - r_kr;
         refresh_rest(f);
         note_edge(f);

@@ -74,12 +74,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.block_sleep_serial.assign(blocks, 0);
   s.wake_key.assign(surface->edge_capacity(), ~std::uint64_t{0});
   s.wake_length.assign(surface->edge_capacity(), 0.0);
-  s.group_begin.assign(blocks + 1, 0);
-  s.group_edges.assign(surface->edge_capacity(), 0);
-  s.partner_begin.assign(blocks + 1, 0);
-  s.partners.assign(surface->edge_capacity() + blocks, 0);
-  s.mark.assign(blocks, 0);
-  s.group_active.assign(blocks, 1);
+  s.groups.reserve(*surface);
   s.springs.resize(surface->edge_capacity());
   s.lambda_distance.resize(surface->edge_capacity());
   s.lambda_direction.resize(surface->edge_capacity());
@@ -228,6 +223,20 @@ Energy TissueWorld::energy() const {
     en.elastic += 0.5 * at.d.stiffness_un_per_mm * (pb - pa).squaredNorm();
   }
   return en;
+}
+
+Status TissueWorld::check_spring_groups() const {
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    const Status st = scratch_[si].groups.check(*surfaces_[si]);
+    if (!st) return Status::error("surface " + std::to_string(si) + ": " + st.message());
+  }
+  return Status::ok();
+}
+
+std::uint64_t TissueWorld::spring_group_rebuilds() const {
+  std::uint64_t n = 0;
+  for (const auto& sc : scratch_) n += sc.groups.rebuilds();
+  return n;
 }
 
 std::uint64_t TissueWorld::state_hash() const {

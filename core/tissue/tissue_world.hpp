@@ -23,6 +23,7 @@
 #include "core/common/types.hpp"
 #include "core/common/units.hpp"
 #include "core/tissue/globe_wall.hpp"
+#include "core/tissue/spring_groups.hpp"
 #include "core/tissue/surface.hpp"
 #include "core/tissue/topology_hook.hpp"
 
@@ -241,6 +242,11 @@ class TissueWorld {
   void wake_all();
   // Awake vertex blocks over all surfaces (for diagnostics and benchmarks).
   std::uint32_t awake_blocks() const;
+  // Ok when the solver's sleep groups of every surface, as the last step left them, are what a
+  // rebuild from the surface's springs would give (spring_groups.hpp; for tests).
+  Status check_spring_groups() const;
+  // Times the solver rebuilt its sleep groups from every spring, over all surfaces (benchmarks).
+  std::uint64_t spring_group_rebuilds() const;
   std::uint32_t total_blocks() const;
 
  private:
@@ -307,12 +313,9 @@ class TissueWorld {
     std::vector<std::uint32_t> block_sleep_serial;
     std::vector<std::uint64_t> wake_key;
     std::vector<double> wake_length;
-    // Springs grouped by the block of their lower vertex, with the other blocks each group
-    // reaches, so a sweep can skip whole groups that touch only sleeping blocks. Rebuilt (without
-    // allocating) whenever the surface's topology changes.
-    std::vector<std::uint32_t> group_begin, group_edges, partner_begin, partners, mark;
-    std::vector<std::uint8_t> group_active;
-    std::uint64_t groups_version = ~std::uint64_t{0};
+    // Springs grouped by sleep block, so a sweep can skip whole groups that touch only sleeping
+    // blocks (spring_groups.hpp). Derived from the topology, not state.
+    SpringGroups groups;
     // The springs this step's sweeps project, in sweep order, with everything that is constant
     // within a step gathered next to them (see pack_springs): the sweep reads one contiguous array
     // instead of five edge arrays through an index, and skips no spring at run time.
@@ -393,12 +396,7 @@ class TissueWorld {
 // decides which), in a fixed order: mesh order within a group, groups in block order.
 template <class F>
 void TissueWorld::for_each_active_edge(std::uint32_t si, F&& f) {
-  const Scratch& sc = scratch_[si];
-  const std::uint32_t groups = static_cast<std::uint32_t>(sc.group_active.size());
-  for (std::uint32_t g = 0; g < groups; ++g) {
-    if (!sc.group_active[g]) continue;
-    for (std::uint32_t i = sc.group_begin[g]; i < sc.group_begin[g + 1]; ++i) f(sc.group_edges[i]);
-  }
+  scratch_[si].groups.for_each_active(f);
 }
 
 }  // namespace vitreo::core

@@ -6,7 +6,8 @@
 // The stroke is measured twice: on a resting shell, stroke after stroke (BM_BladeStroke: the cut's
 // own work, with the shell's data warm from the previous stroke), and right after a solver step
 // each time, as in the rig's loop, where the step has just replaced the caches' contents and the
-// tissue has moved (BM_BladeStrokeAfterStep; the step is not timed). There each retina first
+// tissue has moved (BM_BladeStrokeAfterStep; the step is not timed in the stroke's figures, but
+// reported apart as step_after_stroke_*: the solver's side of a cut's price). There each retina first
 // settles until every block sleeps, as a case's tissue has before the surgeon cuts (a freshly built
 // 20k retina is awake for ~200 steps, and a step of all of it is not what the loop runs).
 //   build/test/bench/bench_topology --benchmark_format=json
@@ -16,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/anatomy/retina_cap.hpp"
@@ -26,13 +28,13 @@ using namespace vitreo::core;
 
 namespace {
 
-void report(benchmark::State& state, std::vector<double>& us) {
+void report(benchmark::State& state, std::vector<double>& us, const std::string& prefix = "") {
   if (us.empty()) return;
   std::sort(us.begin(), us.end());
   auto q = [&](double p) { return us[static_cast<std::size_t>(p * static_cast<double>(us.size() - 1))]; };
-  state.counters["p50_us"] = q(0.5);
-  state.counters["p99_us"] = q(0.99);
-  state.counters["max_us"] = us.back();
+  state.counters[prefix + "p50_us"] = q(0.5);
+  state.counters[prefix + "p99_us"] = q(0.99);
+  state.counters[prefix + "max_us"] = us.back();
 }
 
 RetinaCapScene retina(int vertices) {
@@ -67,17 +69,21 @@ void blade_strokes(benchmark::State& state, bool step_before_each) {
     return;
   }
   std::unique_ptr<Cutter> cutter = std::make_unique<Cutter>(scene.world.surface(scene.retina));
-  std::vector<double> us;
+  std::uint64_t rebuilds0 = scene.world.spring_group_rebuilds();
+  std::vector<double> us, step_us;  // strokes; solver steps right after a stroke
   std::uint32_t opened = 0, strokes = 0, split = 0, snapped = 0, ends = 0;
+  std::uint64_t group_rebuilds = 0;  // the solver's sleep groups rebuilt from every spring (should be none)
   for (auto _ : state) {
     if (strokes > 0 && strokes % kStrokesPerRetina == 0) {  // a new retina (not timed)
       state.PauseTiming();
+      group_rebuilds += scene.world.spring_group_rebuilds() - rebuilds0;
       cutter.reset();
       scene = retina(static_cast<int>(state.range(0)));
       if (step_before_each && !settle(scene)) {
         state.SkipWithError("the retina did not settle");
         break;
       }
+      rebuilds0 = scene.world.spring_group_rebuilds();
       cutter = std::make_unique<Cutter>(scene.world.surface(scene.retina));
       state.ResumeTiming();
     }
@@ -90,10 +96,13 @@ void blade_strokes(benchmark::State& state, bool step_before_each) {
     const BladeEdge from{a * 0.9, a * 1.06}, to{b * 0.9, b * 1.06};
     if (step_before_each) {
       state.PauseTiming();
+      const auto s0 = std::chrono::steady_clock::now();
       if (!scene.world.step(1e-3).ok) {
         state.SkipWithError("the solver step failed");
         break;
       }
+      const auto s1 = std::chrono::steady_clock::now();
+      if (strokes % kStrokesPerRetina != 0) step_us.push_back(std::chrono::duration<double, std::micro>(s1 - s0).count());
       state.ResumeTiming();
     }
     const auto t0 = std::chrono::steady_clock::now();
@@ -116,7 +125,10 @@ void blade_strokes(benchmark::State& state, bool step_before_each) {
   state.counters["snapped_per_stroke"] = strokes ? static_cast<double>(snapped) / strokes : 0.0;
   state.counters["ends_per_stroke"] = strokes ? static_cast<double>(ends) / strokes : 0.0;
   state.counters["strokes"] = strokes;
+  group_rebuilds += scene.world.spring_group_rebuilds() - rebuilds0;
+  if (step_before_each) state.counters["group_rebuilds"] = static_cast<double>(group_rebuilds);
   report(state, us);
+  report(state, step_us, "step_after_stroke_");
 }
 
 void BM_BladeStroke(benchmark::State& state) { blade_strokes(state, false); }
