@@ -26,13 +26,7 @@ Cutter::Cutter(Surface& surface, CutSettings settings)
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
   const std::size_t nt = ne;  // triangle capacity is below the spring capacity
-  cut_stamp_.assign(nv, 0);
-  cut_degree_.assign(nv, 0);
-  near_rim_.assign(nv, 0);
-  rim_mask_.assign(nv, 0);
-  separated_.assign(nv, 0);
-  side_.assign(nv, {0.0, 0.0});
-  side_stamp_.assign(nv, 0);
+  vertex_.assign(nv, VertexScratch{});
   edge_stamp_.assign(ne, 0);
   triangle_stamp_.assign(nt, 0);
   // Scratch sized for the worst case and touched now, so no stroke allocates or takes a page fault.
@@ -74,35 +68,38 @@ std::array<double, 2> Cutter::plane_distances(const Vec3& x) const {
   return d;
 }
 
-const std::array<double, 2>& Cutter::side(std::uint32_t v) {
-  if (side_stamp_[v] != stamp_) {
-    side_stamp_[v] = stamp_;
-    side_[v] = plane_distances(surface_.position(v));
+void Cutter::find_crossings(std::span<const std::uint32_t> springs) {
+  const Surface& s = surface_;
+  const double band2 = settings_.band_mm * settings_.band_mm + 1e-24;
+  // Each vertex's distances once per stroke: its springs share them.
+  auto side = [&](std::uint32_t v) -> const std::array<double, 2>& {
+    if (vertex_[v].side_stamp != stamp_) {
+      vertex_[v].side_stamp = stamp_;
+      vertex_[v].side = plane_distances(s.position(v));
+    }
+    return vertex_[v].side;
+  };
+  for (const std::uint32_t e : springs) {
+    const auto [a, b] = s.edge_vertices(e);
+    const std::array<double, 2> da = side(a), db = side(b);
+    for (std::size_t k = 0; k < 2; ++k) {
+      // A spring crosses plane k where its ends' signed distances differ in sign (a degenerate
+      // triangle has distance 0 everywhere, so never); it crosses the swept surface if the
+      // crossing lies on triangle k (within the band).
+      if (!(da[k] * db[k] < 0.0)) continue;
+      const Vec3 &xa = s.position(a), &xb = s.position(b);
+      const double t = da[k] / (da[k] - db[k]);
+      const Vec3 x = xa + t * (xb - xa);
+      if ((x - closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2])).squaredNorm() > band2) continue;
+      if (crossings_.size() < crossings_.capacity()) crossings_.push_back({s.edge_id(e), t});
+      break;
+    }
   }
-  return side_[v];
-}
-
-// Inline: called for every spring around the cut, and the swept planes stay in registers.
-inline bool Cutter::crosses(std::uint32_t e, double& t) {
-  const auto [a, b] = surface_.edge_vertices(e);
-  const std::array<double, 2> da = side(a), db = side(b);
-  for (std::size_t k = 0; k < 2; ++k) {
-    // A spring crosses plane k where its ends' signed distances differ in sign (an invalid
-    // triangle has distance 0 everywhere, so never).
-    if (!(da[k] * db[k] < 0.0)) continue;
-    const Vec3 &xa = surface_.position(a), &xb = surface_.position(b);
-    t = da[k] / (da[k] - db[k]);
-    const Vec3 x = xa + t * (xb - xa);
-    const Vec3 c = closest_point_on_triangle(x, swept_[k][0], swept_[k][1], swept_[k][2]);
-    const double band = settings_.band_mm;
-    if ((x - c).squaredNorm() <= band * band + 1e-24) return true;
-  }
-  return false;
 }
 
 void Cutter::mark(std::uint32_t v) {
-  if (cut_stamp_[v] == stamp_) return;
-  cut_stamp_[v] = stamp_;
+  if (vertex_[v].cut == stamp_) return;
+  vertex_[v].cut = stamp_;
   on_cut_.push_back(v);
 }
 
@@ -125,16 +122,16 @@ void Cutter::gather_candidates() {
     }
     if (!candidate) return;
     candidates_.push_back(v);
-    side_stamp_[v] = stamp_;  // for the crossing tests of the springs around it
-    side_[v] = d;
+    vertex_[v].side_stamp = stamp_;  // for the crossing tests of the springs around it
+    vertex_[v].side = d;
     if (on_surface) mark(v);  // the vertex and grazing cases
     std::uint8_t mask = 0;
     for (std::size_t k = 0; k < rim_.size(); ++k) {
       if (topology::distance_to_segment(x, rim_[k][0], rim_[k][1]) <= margin_mm_) mask |= static_cast<std::uint8_t>(1u << k);
     }
     if (mask != 0) {
-      near_rim_[v] = stamp_;
-      rim_mask_[v] = mask;
+      vertex_[v].rim = stamp_;
+      vertex_[v].rim_mask = mask;
     }
   };
   // A block can hold a candidate only if its box comes within the margin of the plane of one of
@@ -222,7 +219,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
       ends.at[ends.count++] = y;
     }
   };
-  auto rim_bits = [&](std::uint32_t v) { return near_rim_[v] == stamp_ ? rim_mask_[v] : std::uint8_t{0}; };
+  auto rim_bits = [&](std::uint32_t v) { return vertex_[v].rim == stamp_ ? vertex_[v].rim_mask : std::uint8_t{0}; };
   for (auto t : triangles_) {
     const auto tv = s.triangle_vertices(t);
     // Only triangles near the quad's boundary can hold an end: a rim segment passing through a
@@ -254,10 +251,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   // Crossings of the springs found so far (inserting the ends below only adds springs around the
   // new end vertices; the others keep their crossings, as nothing moves).
   crossings_.clear();
-  for (auto e : edges_) {
-    double t;
-    if (crosses(e, t)) crossings_.push_back({s.edge_id(e), t});
-  }
+  find_crossings(edges_);
   const auto ncross = static_cast<std::uint32_t>(crossings_.size());
   const std::uint32_t k = ends.count + ncross + static_cast<std::uint32_t>(on_cut_.size()) + 2;
   if (!s.has_room(3 * k, 6 * k, 3 * k)) {
@@ -333,7 +327,7 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
     std::uint32_t nv = kNone;
     if (zeros >= 2) {
       nv = tv[static_cast<std::size_t>(std::max_element(w.begin(), w.end()) - w.begin())];
-      if (cut_stamp_[nv] != stamp_) ++r.snapped;
+      if (vertex_[nv].cut != stamp_) ++r.snapped;
     } else if (zeros == 1) {
       const auto j1 = static_cast<std::size_t>((zero_at + 1) % 3), j2 = static_cast<std::size_t>((zero_at + 2) % 3);
       const std::uint32_t e = s.triangle_edges(best)[j1];  // joins corners j1 and j2
@@ -352,7 +346,7 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
       nv = split.vertex;
       created[ncreated++] = nv;
     }
-    if (nv != kNone && cut_stamp_[nv] != stamp_) {
+    if (nv != kNone && vertex_[nv].cut != stamp_) {
       mark(nv);
       candidates_.push_back(nv);
       end_vertices[nend_vertices++] = nv;
@@ -376,6 +370,7 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
     }
     return false;
   };
+  edges_.clear();  // the first search's springs have their crossings; now the new ones
   for (std::uint32_t i = 0; i < nend_vertices; ++i) {
     if (!s.vertex_alive(end_vertices[i])) continue;
     s.for_each_triangle_of(end_vertices[i], [&](std::uint32_t tri, std::uint32_t) {
@@ -385,11 +380,11 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
         edge_stamp_[e] = edge_round_;
         const auto [a, b] = s.edge_vertices(e);
         if (!is_created(a) && !is_created(b) && seen_before) continue;  // in the first search
-        double t;
-        if (crosses(e, t) && crossings_.size() < crossings_.capacity()) crossings_.push_back({s.edge_id(e), t});
+        edges_.push_back(e);
       }
     });
   }
+  find_crossings(edges_);
   // Snap the crossings near a vertex (in order; a snapped vertex settles its other springs).
   std::size_t kept = 0;
   for (std::size_t i = 0; i < crossings_.size(); ++i) {
@@ -397,7 +392,7 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
     if (!s.is_current(c.edge)) continue;  // split by an end
     const double t = c.t;
     const auto [a, b] = s.edge_vertices(c.edge.index);
-    if (cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;
+    if (vertex_[a].cut == stamp_ || vertex_[b].cut == stamp_) continue;
     // Band in the current shape, the floor on pieces in the rest shape (what the springs keep).
     const double len = (s.position(b) - s.position(a)).norm(), rest = s.edge_rest_length(c.edge.index);
     const double floor_mm = settings_.min_piece_mm;
@@ -414,7 +409,7 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
   crossings_.resize(kept);
   for (const auto& c : crossings_) {
     const auto [a, b] = s.edge_vertices(c.edge.index);
-    if (!s.is_current(c.edge) || cut_stamp_[a] == stamp_ || cut_stamp_[b] == stamp_) continue;
+    if (!s.is_current(c.edge) || vertex_[a].cut == stamp_ || vertex_[b].cut == stamp_) continue;
     const auto split = s.split_edge(c.edge, c.t);
     if (!split.status) continue;
     mark(split.vertex);
@@ -424,8 +419,8 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
   // 3. Springs along the cut.
   ++edge_round_;
   to_open_.clear();
-  auto on_cut = [&](std::uint32_t v) { return cut_stamp_[v] == stamp_; };
-  for (auto v : on_cut_) cut_degree_[v] = 0;
+  auto on_cut = [&](std::uint32_t v) { return vertex_[v].cut == stamp_; };
+  for (auto v : on_cut_) vertex_[v].cut_degree = 0;
   for (std::size_t i = 0; i < on_cut_.size(); ++i) {
     const std::uint32_t v = on_cut_[i];
     s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
@@ -438,8 +433,8 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
         const double len = (s.position(b) - s.position(a)).norm();
         if (!near_swept(mid, band + snap * len)) continue;
         to_open_.push_back(s.edge_id(e));
-        if (cut_degree_[a] < 255) ++cut_degree_[a];
-        if (cut_degree_[b] < 255) ++cut_degree_[b];
+        if (vertex_[a].cut_degree < 255) ++vertex_[a].cut_degree;
+        if (vertex_[b].cut_degree < 255) ++vertex_[b].cut_degree;
       }
     });
   }
@@ -455,13 +450,13 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
     const EdgeId id = to_open_[i];
     if (s.edge_triangles(id.index)[1] == kNone) continue;  // already a boundary: nothing to open
     const auto [a, b] = s.edge_vertices(id.index);
-    if (cut_degree_[a] != 1 || cut_degree_[b] != 1 || !interior(a) || !interior(b)) continue;
+    if (vertex_[a].cut_degree != 1 || vertex_[b].cut_degree != 1 || !interior(a) || !interior(b)) continue;
     // A slit of one spring could not open: give it a middle vertex.
     const auto split = s.split_edge(id, 0.5);
     if (!split.status) continue;
     const std::uint32_t m = split.vertex;
     mark(m);
-    cut_degree_[m] = 2;
+    vertex_[m].cut_degree = 2;
     to_open_[i] = s.edge_id(s.find_edge(a, m));
     to_open_.push_back(s.edge_id(s.find_edge(m, b)));
     ++r.springs_split;
@@ -473,13 +468,13 @@ void Cutter::insert_cut(CutResult& r, const Ends& ends) {
   for (const auto& id : to_open_) {
     if (!s.is_current(id)) continue;
     for (auto v : s.edge_vertices(id.index)) {
-      if (!s.vertex_alive(v) || separated_[v] == stamp_) continue;  // once per vertex
-      separated_[v] = stamp_;
+      if (!s.vertex_alive(v) || vertex_[v].separated == stamp_) continue;  // once per vertex
+      vertex_[v].separated = stamp_;
       const std::size_t before = on_cut_.size();
       r.vertices_added += s.separate_vertex_fans(s.vertex_id(v), &on_cut_);  // copies join the cut
       // A copy takes one fan whole: there is nothing to separate at it (the opened springs now
       // name it, so without this each would be visited again).
-      for (std::size_t i = before; i < on_cut_.size(); ++i) separated_[on_cut_[i]] = stamp_;
+      for (std::size_t i = before; i < on_cut_.size(); ++i) vertex_[on_cut_[i]].separated = stamp_;
     }
   }
   r.vertices_added += r.end_points + r.springs_split;

@@ -31,6 +31,7 @@
 // (non-finite pose, degenerate blade or sweep, full pools) return an error and change nothing.
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/common/status.hpp"
@@ -100,10 +101,9 @@ class Cutter {
   bool near_swept(const Vec3& p, double tolerance) const;
   // Signed distances of x to the planes of the two swept triangles (0 for a degenerate one).
   std::array<double, 2> plane_distances(const Vec3& x) const;
-  // The same for vertex v, computed once per stroke (the springs around a vertex share it).
-  const std::array<double, 2>& side(std::uint32_t v);
-  // Whether spring e crosses the swept surface (within the band), and where (t from its first end).
-  bool crosses(std::uint32_t e, double& t);
+  // Appends to crossings_ each of these springs that crosses the swept surface (within the band),
+  // with where (t from its first end).
+  void find_crossings(std::span<const std::uint32_t> springs);
   void insert_cut(CutResult& r, const Ends& ends);
   void gather_candidates();
   void gather_edges();
@@ -122,7 +122,7 @@ class Cutter {
   Vec3 box_lo_ = Vec3::Zero(), box_hi_ = Vec3::Zero();
   // Scratch, sized once.
   std::uint32_t stamp_ = 0, edge_round_ = 0;
-  std::vector<std::uint32_t> edge_stamp_, triangle_stamp_, cut_stamp_;
+  std::vector<std::uint32_t> edge_stamp_, triangle_stamp_;
   std::vector<std::uint32_t> candidates_, triangles_, edges_, on_cut_;
   struct Crossing {
     EdgeId edge;
@@ -130,11 +130,19 @@ class Cutter {
   };
   std::vector<Crossing> crossings_;
   std::vector<EdgeId> to_open_;
-  std::vector<std::uint8_t> cut_degree_;
-  std::vector<std::uint32_t> near_rim_, separated_;  // == stamp_: within the margin of the quad's boundary
-  std::vector<std::uint8_t> rim_mask_;
-  std::vector<std::array<double, 2>> side_;  // plane_distances of vertex v, where side_stamp_[v] == stamp_
-  std::vector<std::uint32_t> side_stamp_;  // where near_rim_ == stamp_: bit k, within the margin of rim_[k]
+  // What a stroke keeps per vertex, in one record (a vertex costs one cache line, not six: the
+  // stroke visits a few hundred vertices scattered over the surface). A field is this stroke's
+  // where its stamp equals stamp_.
+  struct VertexScratch {
+    std::array<double, 2> side{};     // plane_distances (side_stamp)
+    std::uint32_t side_stamp = 0;
+    std::uint32_t cut = 0;            // on the cut (stamp)
+    std::uint32_t rim = 0;            // within the margin of the quad's boundary (stamp) ...
+    std::uint32_t separated = 0;      // its fans were separated (stamp)
+    std::uint8_t rim_mask = 0;        // ... bit k: within the margin of rim_[k]
+    std::uint8_t cut_degree = 0;      // opened springs along the cut at it (set in step 3)
+  };
+  std::vector<VertexScratch> vertex_;
 };
 
 }  // namespace vitreo::core

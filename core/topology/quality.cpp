@@ -20,18 +20,26 @@ void QualitySettings::validate() const {
   if (max_passes < 1 || max_passes > 64) throw InvalidArgument("quality: max_passes must be in [1, 64]");
 }
 
-bool is_poor_triangle(const Surface& s, std::uint32_t t, const QualitySettings& q) {
+namespace {
+
+double sin2_of_degrees(double deg) {
+  const double s = std::sin(deg * std::numbers::pi / 180.0);
+  return s * s;
+}
+
+// is_poor_triangle with the angle limit as sin² (0: no angle limit), computed once by the caller.
+bool poor_triangle(const Surface& s, std::uint32_t t, double min_spring_mm, double min_angle_sin2) {
   const auto tv = s.triangle_vertices(t);
   const auto te = s.triangle_edges(t);
   std::array<Vec3, 3> d;  // d[k]: from corner k to corner k + 1 (rest vectors)
   for (std::uint32_t k = 0; k < 3; ++k) {
-    if (s.edge_rest_length(te[k]) < q.min_spring_mm) return true;
+    if (s.edge_rest_length(te[k]) < min_spring_mm) return true;
     d[k] = s.edge_vertices(te[k])[0] == tv[k] ? s.edge_rest_vector(te[k]) : Vec3(-s.edge_rest_vector(te[k]));
   }
-  if (!(q.min_angle_deg > 0.0)) return false;
+  if (!(min_angle_sin2 > 0.0)) return false;
   // Angle at corner k between d[k] and −d[k−1] below θ ⇔ acute with sin² below sin²θ (no atan2:
   // this runs on every triangle around a cut).
-  const double sin_min = std::sin(q.min_angle_deg * std::numbers::pi / 180.0), sin2 = sin_min * sin_min;
+  const double sin2 = min_angle_sin2;
   for (std::uint32_t k = 0; k < 3; ++k) {
     const Vec3& u = d[k];
     const Vec3 w = -d[(k + 2) % 3];
@@ -41,8 +49,15 @@ bool is_poor_triangle(const Surface& s, std::uint32_t t, const QualitySettings& 
   return false;
 }
 
+}  // namespace
+
+bool is_poor_triangle(const Surface& s, std::uint32_t t, const QualitySettings& q) {
+  return poor_triangle(s, t, q.min_spring_mm, q.min_angle_deg > 0.0 ? sin2_of_degrees(q.min_angle_deg) : 0.0);
+}
+
 MeshQuality::MeshQuality(Surface& surface, QualitySettings settings) : surface_(surface), settings_(settings) {
   settings_.validate();
+  min_angle_sin2_ = settings_.min_angle_deg > 0.0 ? sin2_of_degrees(settings_.min_angle_deg) : 0.0;
   reserve_touched(work_, surface.vertex_capacity());
   reserve_touched(next_, surface.vertex_capacity());
   reserve_touched(seeds_, surface.vertex_capacity());
@@ -193,7 +208,7 @@ QualityResult MeshQuality::clean_around(std::span<const std::uint32_t> vertices)
         std::uint32_t poor = kNone;
         s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
           if (poor != kNone || tri_stamp_[t] == round_) return;
-          if (is_poor_triangle(s, t, settings_)) {
+          if (poor_triangle(s, t, settings_.min_spring_mm, min_angle_sin2_)) {
             poor = t;
           } else {
             tri_stamp_[t] = round_;  // checked and fine in this pass
