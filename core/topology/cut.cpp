@@ -71,14 +71,6 @@ std::array<double, 2> Cutter::plane_distances(const Vec3& x) const {
 void Cutter::find_crossings(std::span<const std::uint32_t> springs) {
   const Surface& s = surface_;
   const double band2 = settings_.band_mm * settings_.band_mm + 1e-24;
-  // Each vertex's distances once per stroke: its springs share them.
-  auto side = [&](std::uint32_t v) -> const std::array<double, 2>& {
-    if (vertex_[v].side_stamp != stamp_) {
-      vertex_[v].side_stamp = stamp_;
-      vertex_[v].side = plane_distances(s.position(v));
-    }
-    return vertex_[v].side;
-  };
   for (const std::uint32_t e : springs) {
     const auto [a, b] = s.edge_vertices(e);
     const std::array<double, 2> da = side(a), db = side(b);
@@ -128,6 +120,7 @@ void Cutter::gather_candidates() {
     std::uint8_t mask = 0;
     for (std::size_t k = 0; k < rim_.size(); ++k) {
       if (topology::distance_to_segment(x, rim_[k][0], rim_[k][1]) <= margin_mm_) mask |= static_cast<std::uint8_t>(1u << k);
+      if ((x - corners_[k]).squaredNorm() <= margin_mm_ * margin_mm_) mask |= static_cast<std::uint8_t>(16u << k);
     }
     if (mask != 0) {
       vertex_[v].rim = stamp_;
@@ -205,6 +198,7 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
   ++stamp_;
   on_cut_.clear();
   rim_ = {{{p0, q0}, {p1, q1}, {p0, p1}, {q0, q1}}};
+  corners_ = {p0, q0, p1, q1};
   gather_candidates();  // also marks the vertices on the swept surface
   gather_edges();
 
@@ -220,29 +214,36 @@ CutResult Cutter::sweep(const BladeEdge& from, const BladeEdge& to) {
     }
   };
   auto rim_bits = [&](std::uint32_t v) { return vertex_[v].rim == stamp_ ? vertex_[v].rim_mask : std::uint8_t{0}; };
+  // The swept triangle whose plane holds each rim segment (p0q0 and q0q1 lie in (p0, q0, q1),
+  // p1q1 and p0p1 in (p0, q1, p1)).
+  constexpr std::array<std::size_t, 4> kRimPlane{0, 1, 1, 0};
   for (auto t : triangles_) {
     const auto tv = s.triangle_vertices(t);
     // Only triangles near the quad's boundary can hold an end: a rim segment passing through a
-    // triangle passes within the margin of one of its corners (see the constructor).
+    // triangle passes within the margin of one of its corners (see the constructor), and so
+    // does a quad corner resting on it (bits 4–7).
     const std::uint8_t any = rim_bits(tv[0]) | rim_bits(tv[1]) | rim_bits(tv[2]);
     if (any == 0) continue;
     for (std::size_t k = 0; k < boundary.size(); ++k) {
       if (!(any & (1u << k))) continue;
       const auto& seg = boundary[k];
       if ((seg[1] - seg[0]).squaredNorm() < 1e-24) continue;
+      // The segment lies in the plane of a swept triangle: a triangle wholly on one side of that
+      // plane (beyond the band) cannot meet it.
+      const std::size_t plane = kRimPlane[k];
+      if (swept_valid_[plane]) {
+        const double d0 = side(tv[0])[plane], d1 = side(tv[1])[plane], d2 = side(tv[2])[plane];
+        if ((d0 > band && d1 > band && d2 > band) || (d0 < -band && d1 < -band && d2 < -band)) continue;
+      }
       double sp;
       std::array<double, 3> bary;
       if (!segment_triangle(seg[0], seg[1], s.position(tv[0]), s.position(tv[1]), s.position(tv[2]), sp, bary)) continue;
       add_end(seg[0] + sp * (seg[1] - seg[0]), t);
     }
     // A corner of the quad resting on the triangle (within the band) ends the cut there too.
-    for (const Vec3& c : {p0, q0, p1, q1}) {
-      // Cheap rejection: a corner on the triangle lies within the margin of its nearest corner.
-      const double m2 = margin_mm_ * margin_mm_;
-      if ((c - s.position(tv[0])).squaredNorm() > m2 && (c - s.position(tv[1])).squaredNorm() > m2 &&
-          (c - s.position(tv[2])).squaredNorm() > m2) {
-        continue;
-      }
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (!(any & (16u << k))) continue;
+      const Vec3& c = corners_[k];
       const Vec3 y = closest_point_on_triangle(c, s.position(tv[0]), s.position(tv[1]), s.position(tv[2]));
       if ((y - c).norm() <= band) add_end(y, t);
     }

@@ -101,6 +101,16 @@ class Cutter {
   bool near_swept(const Vec3& p, double tolerance) const;
   // Signed distances of x to the planes of the two swept triangles (0 for a degenerate one).
   std::array<double, 2> plane_distances(const Vec3& x) const;
+  // Vertex v's plane_distances, computed once per stroke (the springs and triangles around a
+  // vertex share it).
+  const std::array<double, 2>& side(std::uint32_t v) {
+    VertexScratch& vs = vertex_[v];
+    if (vs.side_stamp != stamp_) {
+      vs.side_stamp = stamp_;
+      vs.side = plane_distances(surface_.position(v));
+    }
+    return vs.side;
+  }
   // Appends to crossings_ each of these springs that crosses the swept surface (within the band),
   // with where (t from its first end).
   void find_crossings(std::span<const std::uint32_t> springs);
@@ -119,6 +129,7 @@ class Cutter {
   std::array<Vec3, 2> swept_normal_{};
   std::array<bool, 2> swept_valid_{};
   std::array<std::array<Vec3, 2>, 4> rim_{};  // the quad's boundary: blade at both poses, end paths
+  std::array<Vec3, 4> corners_{};             // the quad's corners p0, q0, p1, q1
   Vec3 box_lo_ = Vec3::Zero(), box_hi_ = Vec3::Zero();
   // Scratch, sized once.
   std::uint32_t stamp_ = 0, edge_round_ = 0;
@@ -139,7 +150,7 @@ class Cutter {
     std::uint32_t cut = 0;            // on the cut (stamp)
     std::uint32_t rim = 0;            // within the margin of the quad's boundary (stamp) ...
     std::uint32_t separated = 0;      // its fans were separated (stamp)
-    std::uint8_t rim_mask = 0;        // ... bit k: within the margin of rim_[k]
+    std::uint8_t rim_mask = 0;        // ... bit k: within the margin of rim_[k]; bit 4 + k: of corners_[k]
     std::uint8_t cut_degree = 0;      // opened springs along the cut at it (set in step 3)
   };
   std::vector<VertexScratch> vertex_;
