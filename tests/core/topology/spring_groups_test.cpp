@@ -114,3 +114,37 @@ TEST(SpringGroups, MoreChangesThanTheLogHoldsRebuildFromEverySpring) {
   const Status groups = scene.world.check_spring_groups();
   EXPECT_TRUE(groups) << groups.message();
 }
+
+TEST(SpringGroups, AGroupThatOutgrowsItsRoomIsRebuiltAndStaysExact) {
+  RetinaCapScene scene = small_retina();
+  ASSERT_TRUE(scene.world.step(1e-3).ok);
+  const std::uint64_t rebuilds0 = scene.world.spring_group_rebuilds();
+  Surface& s = scene.world.surface(scene.retina);
+  Cutter cutter(s);
+  // A cross-hatch of strokes through the same few blocks, a step after each: their groups gain
+  // springs with every stroke until one outgrows the room it was given.
+  int i = 0;
+  for (; i < 300 && scene.world.spring_group_rebuilds() == rebuilds0; ++i) {
+    const double along = 0.5 + 0.03 * (i / 2);
+    Vec3 a, b;
+    if (i % 2 == 0) {  // along a meridian
+      a = on_globe(0.5, along);
+      b = on_globe(0.5 + 1.5 / 12.0, along);
+    } else {  // along a parallel
+      a = on_globe(0.5 + 0.03 * (i / 2), 0.45);
+      b = on_globe(0.5 + 0.03 * (i / 2), 0.45 + 1.5 / (12.0 * std::sin(0.5)));
+    }
+    ASSERT_TRUE(cutter.sweep({a * 0.9, a * 1.06}, {b * 0.9, b * 1.06}).status);
+    ASSERT_TRUE(scene.world.step(1e-3).ok);
+    const Status groups = scene.world.check_spring_groups();
+    ASSERT_TRUE(groups) << "after stroke " << i << ": " << groups.message();
+  }
+  EXPECT_GT(scene.world.spring_group_rebuilds(), rebuilds0) << "no group outgrew its room in " << i << " strokes";
+  // And after the rebuild, following the log again.
+  const std::uint64_t rebuilds1 = scene.world.spring_group_rebuilds();
+  const Vec3 a = on_globe(1.0, 2.0), b = on_globe(1.0 + 1.5 / 12.0, 2.0);
+  ASSERT_TRUE(cutter.sweep({a * 0.9, a * 1.06}, {b * 0.9, b * 1.06}).status);
+  ASSERT_TRUE(scene.world.step(1e-3).ok);
+  EXPECT_TRUE(scene.world.check_spring_groups());
+  EXPECT_EQ(scene.world.spring_group_rebuilds(), rebuilds1);
+}
