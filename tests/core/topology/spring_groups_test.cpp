@@ -29,6 +29,11 @@ Vec3 on_globe(double theta, double phi, double r = 12.0) {
   return r * Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), -std::cos(theta));
 }
 
+// A radial blade (through the retina) swept from one point on it to another.
+CutResult radial_stroke(Cutter& cutter, const Vec3& from, const Vec3& to) {
+  return cutter.sweep({from * 0.9, from * 1.06}, {to * 0.9, to * 1.06});
+}
+
 // Operation i of a fixed sequence: blade strokes along meridians, vitrector suction with removal,
 // and torn springs, at places that move around the retina.
 void operate(RetinaCapScene& scene, Cutter& cutter, Vitrector& vitrector, int i) {
@@ -36,7 +41,7 @@ void operate(RetinaCapScene& scene, Cutter& cutter, Vitrector& vitrector, int i)
   const double phi = 0.37 * i;
   if (i % 3 == 0) {
     const Vec3 a = on_globe(0.4, phi), b = on_globe(0.4 + 2.0 / 12.0, phi + 0.05);
-    ASSERT_TRUE(cutter.sweep({a * 0.9, a * 1.06}, {b * 0.9, b * 1.06}).status);
+    ASSERT_TRUE(radial_stroke(cutter, a, b).status);
   } else if (i % 3 == 1) {
     const Vec3 p = on_globe(0.9, phi);
     ASSERT_TRUE(vitrector.set_pose(p * (1.0 - 0.15 / 12.0), p));
@@ -97,7 +102,7 @@ TEST(SpringGroups, FollowCutsSuctionAndTearsExactlyWithoutRebuilding) {
 
 TEST(SpringGroups, MoreChangesThanTheLogHoldsRebuildFromEverySpring) {
   RetinaCapScene scene = small_retina();
-  ASSERT_TRUE(scene.world.step(1e-3).ok);
+  ASSERT_TRUE(scene.world.step(1e-3).ok);  // builds the groups
   const std::uint64_t rebuilds0 = scene.world.spring_group_rebuilds();
   Surface& s = scene.world.surface(scene.retina);
   Cutter cutter(s);
@@ -106,7 +111,7 @@ TEST(SpringGroups, MoreChangesThanTheLogHoldsRebuildFromEverySpring) {
   for (int i = 0; s.spring_log_end() - log0 <= Surface::kSpringLogSize && i < 200; ++i) {
     const double phi = 0.11 * i;
     const Vec3 a = on_globe(0.3, phi), b = on_globe(0.3 + 3.0 / 12.0, phi);
-    ASSERT_TRUE(cutter.sweep({a * 0.9, a * 1.06}, {b * 0.9, b * 1.06}).status);
+    ASSERT_TRUE(radial_stroke(cutter, a, b).status);
   }
   ASSERT_TRUE(s.spring_log_lost(log0));
   ASSERT_TRUE(scene.world.step(1e-3).ok);
@@ -134,7 +139,7 @@ TEST(SpringGroups, AGroupThatOutgrowsItsRoomIsRebuiltAndStaysExact) {
       a = on_globe(0.5 + 0.03 * (i / 2), 0.45);
       b = on_globe(0.5 + 0.03 * (i / 2), 0.45 + 1.5 / (12.0 * std::sin(0.5)));
     }
-    ASSERT_TRUE(cutter.sweep({a * 0.9, a * 1.06}, {b * 0.9, b * 1.06}).status);
+    ASSERT_TRUE(radial_stroke(cutter, a, b).status);
     ASSERT_TRUE(scene.world.step(1e-3).ok);
     const Status groups = scene.world.check_spring_groups();
     ASSERT_TRUE(groups) << "after stroke " << i << ": " << groups.message();
@@ -143,7 +148,7 @@ TEST(SpringGroups, AGroupThatOutgrowsItsRoomIsRebuiltAndStaysExact) {
   // And after the rebuild, following the log again.
   const std::uint64_t rebuilds1 = scene.world.spring_group_rebuilds();
   const Vec3 a = on_globe(1.0, 2.0), b = on_globe(1.0 + 1.5 / 12.0, 2.0);
-  ASSERT_TRUE(cutter.sweep({a * 0.9, a * 1.06}, {b * 0.9, b * 1.06}).status);
+  ASSERT_TRUE(radial_stroke(cutter, a, b).status);
   ASSERT_TRUE(scene.world.step(1e-3).ok);
   EXPECT_TRUE(scene.world.check_spring_groups());
   EXPECT_EQ(scene.world.spring_group_rebuilds(), rebuilds1);
