@@ -213,7 +213,10 @@ class Surface {
   // allow_pinch: collapse an interior spring between two boundary vertices anyway and give each
   // fan of the kept vertex its own vertex afterwards (the surface parts there: for necks narrower
   // than the minimum spring, which would tear at once).
-  CollapseResult collapse_edge(EdgeId e, std::uint32_t keep, double min_result_angle_rad = 0.0, bool allow_pinch = false);
+  // min_result_spring_mm: refuse, too, when a spring moved from the removed vertex to keep would get
+  // a shorter rest length than this (the cleanup's floor: a collapse must not make another sliver).
+  CollapseResult collapse_edge(EdgeId e, std::uint32_t keep, double min_result_angle_rad = 0.0, bool allow_pinch = false,
+                               double min_result_spring_mm = 0.0);
   // Merges triangle t into `receiver`, a triangle sharing a spring with it: t goes (springs left
   // without a triangle go, bow-ties are separated) and its rest area is added to the receiver's,
   // so mass stays exact; where t lay the surface opens (for slivers no collapse can remove).

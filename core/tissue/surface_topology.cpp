@@ -54,7 +54,7 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
   const auto tris = edge_t_[e];
 
   struct Side {
-    std::uint32_t o = kNone, e_ao = kNone, e_bo = kNone;
+    std::uint32_t tri = kNone, o = kNone, e_ao = kNone, e_bo = kNone;
     Vec3 r_a_o = Vec3::Zero();
     double area = 0.0, traction = 1.0;
     bool a_first = false;
@@ -64,6 +64,7 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
   for (auto tri : tris) {
     if (tri == kNone) continue;
     Side& s = sides[static_cast<std::size_t>(n++)];
+    s.tri = tri;
     const auto tv = tri_v_[tri];
     for (std::uint32_t k = 0; k < 3; ++k) {
       if (tv[k] != a && tv[k] != b) s.o = tv[k];
@@ -93,34 +94,49 @@ Surface::SplitResult Surface::split_edge(EdgeId id, double t) {
     }
   }
   const EditBatch edit(*this);
-  for (auto tri : tris) {
-    if (tri != kNone) free_triangle(tri);
-  }
-  free_edge(e);
-
+  ++topology_version_;
   const std::uint32_t m = allocate_vertex();
   x_[m] = (1.0 - t) * x_[a] + t * x_[b];
   v_[m] = (1.0 - t) * v_[a] + t * v_[b];
   rest_[m] = (1.0 - t) * rest_[a] + t * rest_[b];
   fixed_[m] = fixed_[a] && fixed_[b];
 
-  const std::uint32_t e_am = add_edge(a, m, t * r_ab, traction);
+  // In place, as if the spring and its triangles were removed and four triangles added, without
+  // unlinking and relinking what stays: the spring's slot becomes a–m and each triangle's slot
+  // keeps a and o, with m in b's corner. Their generations move on, so handles to the spring
+  // a–b and to the triangles a–b–o go stale as they would have.
+  ++edge_generation_[e];
+  edge_v_[e] = {a, m};
+  base_rest_vec_[e] = t * r_ab;
+  refresh_rest(e);
+  log_spring(e);
+  note_edge(e);
+  wake_vertex(a);
+  wake_vertex(b);
   const std::uint32_t e_mb = add_edge(m, b, (1.0 - t) * r_ab, traction);
-  auto make_triangle = [&](std::array<std::uint32_t, 3> v, std::array<std::uint32_t, 3> edges, double area) {
-    const std::uint32_t tri = add_triangle(v, area);
-    tri_e_[tri] = edges;
-    for (auto e2 : edges) attach_triangle_to_edge(e2, tri);
-  };
   for (int i = 0; i < n; ++i) {
     const Side& s = sides[static_cast<std::size_t>(i)];
+    const std::uint32_t tri = s.tri;
     const std::uint32_t e_mo = add_edge(m, s.o, s.r_a_o - t * r_ab, s.traction);
-    if (s.a_first) {  // (a, b, o) → (a, m, o) + (m, b, o)
-      make_triangle({a, m, s.o}, {e_am, e_mo, s.e_ao}, t * s.area);
-      make_triangle({m, b, s.o}, {e_mb, s.e_bo, e_mo}, (1.0 - t) * s.area);
-    } else {  // (b, a, o) → (b, m, o) + (m, a, o)
-      make_triangle({b, m, s.o}, {e_mb, e_mo, s.e_bo}, (1.0 - t) * s.area);
-      make_triangle({m, a, s.o}, {e_am, s.e_ao, e_mo}, t * s.area);
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      if (tri_v_[tri][k] == b) {
+        unlink_corner(tri, k);
+        tri_v_[tri][k] = m;
+        link_corner(tri, k);
+      }
+      if (tri_e_[tri][k] == s.e_bo) tri_e_[tri][k] = e_mo;
     }
+    detach_triangle_from_edge(s.e_bo, tri);
+    attach_triangle_to_edge(e_mo, tri);
+    tri_rest_area_[tri] = t * s.area;
+    ++tri_generation_[tri];
+    note_triangle_area(tri);
+    // The other part, (m, b, o) in the triangle's orientation.
+    const std::uint32_t part = s.a_first ? add_triangle({m, b, s.o}, (1.0 - t) * s.area)
+                                         : add_triangle({b, m, s.o}, (1.0 - t) * s.area);
+    tri_e_[part] = s.a_first ? std::array<std::uint32_t, 3>{e_mb, s.e_bo, e_mo}
+                             : std::array<std::uint32_t, 3>{e_mb, e_mo, s.e_bo};
+    for (auto e2 : tri_e_[part]) attach_triangle_to_edge(e2, part);
   }
   r.vertex = m;
   return r;
@@ -319,7 +335,8 @@ bool Surface::is_boundary_vertex(std::uint32_t v) const {
   return boundary;
 }
 
-Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, double min_result_angle, bool allow_pinch) {
+Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, double min_result_angle, bool allow_pinch,
+                                               double min_result_spring_mm) {
   CollapseResult res;
   auto refuse = [&](const char* why) {
     res.status = Status::error(why);
@@ -443,6 +460,13 @@ Surface::CollapseResult Surface::collapse_edge(EdgeId id, std::uint32_t k, doubl
     if (!(n_old.dot(n_new) > 0.0)) return refuse("collapse_edge: a triangle would flip in the rest shape");
     if (min_angle(d_new[0], d_new[1], d_new[2]) < min_result_angle) {
       return refuse("collapse_edge: a triangle would get a rest angle below the limit");
+    }
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      const auto fv = edge_v_[te[c]];
+      const bool moved = (fv[0] == r || fv[1] == r) && merged_into(te[c]) == kNone;
+      if (moved && d_new[c].norm() < min_result_spring_mm) {
+        return refuse("collapse_edge: a spring moved to the kept vertex would be shorter than the limit");
+      }
     }
     const Vec3 c_old = (x_[tv[1]] - x_[tv[0]]).cross(x_[tv[2]] - x_[tv[0]]);
     const Vec3 c_new = (x_new[1] - x_new[0]).cross(x_new[2] - x_new[0]);

@@ -79,7 +79,6 @@ bool MeshQuality::try_fix(std::uint32_t t) {
     if (s.is_fixed(v) || s.extra_mass(v) > 0.0) return 2;
     return s.is_boundary_vertex(v) ? 1 : 0;
   };
-  --budget_;
   for (auto e : order) {
     const auto [a, b] = s.edge_vertices(e);
     const int ra = rank(a), rb = rank(b);
@@ -92,7 +91,7 @@ bool MeshQuality::try_fix(std::uint32_t t) {
       // A spring below the minimum between two boundary vertices is a neck narrower than it:
       // the surface parts there (Surface::collapse_edge, allow_pinch).
       const bool neck = s.edge_rest_length(e) < settings_.min_spring_mm;
-      const auto r = s.collapse_edge(s.edge_id(e), keep, min_result, neck);
+      const auto r = s.collapse_edge(s.edge_id(e), keep, min_result, neck, settings_.min_spring_mm);
       if (r.status) {
         ++result_.collapses;
         if (next_.size() < next_.capacity()) next_.push_back(keep);
@@ -138,13 +137,19 @@ bool MeshQuality::try_fix(std::uint32_t t) {
       flip_ok = angle_ok(zero, a_apex, a_x) && angle_ok(a_apex, ab, a_x);
     }
   }
-  if (flip_ok && foot > 0.05 && foot < 0.95 && s.has_room(1, 4, 2)) {
+  // A needle (a spring below the minimum that no collapse could remove) is no cap: flipping it
+  // only moves the short spring on, flip after flip, until the passes run out (seen 2026-11-25 on
+  // a sheet pulled out of shape, where every collapse would flip a triangle in the current shape);
+  // it goes to the last resort.
+  const bool needle = s.edge_rest_length(order[0]) < settings_.min_spring_mm;
+  if (!needle && flip_ok && foot > 0.05 && foot < 0.95 && budget_ > 0 && s.has_room(1, 4, 2)) {
+    --budget_;
     const auto split = s.split_edge(s.edge_id(longest), foot);
     if (split.status) {
       const std::uint32_t m = split.vertex, spoke = s.find_edge(m, apex);
       if (spoke != kNone) {
         const bool neck = s.edge_rest_length(spoke) < settings_.min_spring_mm;
-        if (s.collapse_edge(s.edge_id(spoke), apex, limit, neck).status) {
+        if (s.collapse_edge(s.edge_id(spoke), apex, limit, neck, settings_.min_spring_mm).status) {
           ++result_.collapses;
           if (next_.size() < next_.capacity()) next_.push_back(apex);
           return true;
@@ -191,10 +196,13 @@ QualityResult MeshQuality::clean_around(std::span<const std::uint32_t> vertices)
   for (auto v : vertices) {
     if (work_.size() < work_.capacity()) work_.push_back(v);
   }
-  // Every fix removes a vertex or a triangle, or splits a cap once; the budget bounds the rare
-  // chains of splits so a call always ends.
+  // Every fix removes a vertex or a triangle (so they cannot go on for ever), or splits a cap once
+  // (a flip, which removes nothing): the budget bounds those, so a call always ends. It bounded
+  // every attempt before 2026-11-25, and a cascade of collapses through a shredded sheet (42 from
+  // one tear) could spend it and leave a sliver the next attempt would have collapsed.
   budget_ = 4 * static_cast<std::uint64_t>(work_.size()) + 64;
   std::uint32_t unresolved_in_pass = 0;
+  bool pending = false;  // the last pass changed the mesh: work_ holds where to look again
   for (std::uint32_t pass = 0; pass < settings_.max_passes && !work_.empty(); ++pass) {
     ++round_;
     next_.clear();
@@ -215,7 +223,7 @@ QualityResult MeshQuality::clean_around(std::span<const std::uint32_t> vertices)
           }
         });
         if (poor == kNone) break;
-        if (budget_ == 0 || !try_fix(poor)) {
+        if (!try_fix(poor)) {
           tri_stamp_[poor] = round_;
           ++unresolved_in_pass;
           // Try again next pass: a fix next to it may make it fixable.
@@ -227,8 +235,22 @@ QualityResult MeshQuality::clean_around(std::span<const std::uint32_t> vertices)
         }
       }
     }
+    pending = progress_in_pass;
     if (!progress_in_pass) break;  // nothing changed: another pass would find the same
     work_.swap(next_);
+  }
+  if (pending) {
+    // Out of passes with fixes still under way: what is poor where the next pass would have
+    // looked is left as it is, and said so.
+    ++round_;
+    for (const std::uint32_t v : work_) {
+      if (!s.vertex_alive(v)) continue;
+      s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+        if (tri_stamp_[t] == round_) return;
+        tri_stamp_[t] = round_;
+        if (poor_triangle(s, t, settings_.min_spring_mm, min_angle_sin2_)) ++unresolved_in_pass;
+      });
+    }
   }
   result_.unresolved = unresolved_in_pass;
   total_removed_mass_g_ += result_.removed_mass_g;

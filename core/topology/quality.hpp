@@ -82,7 +82,7 @@ class MeshQuality {
   double min_angle_sin2_ = 0.0;  // sin² of settings_.min_angle_deg (0: no angle limit)
   std::vector<std::uint32_t> work_, next_, tri_stamp_, seeds_;
   std::uint32_t round_ = 0;
-  std::uint64_t budget_ = 0;
+  std::uint64_t budget_ = 0;  // cap splits (flips) this clean_around may still make
   double total_removed_mass_g_ = 0.0;
   QualityResult result_;
 };
