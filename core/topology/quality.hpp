@@ -17,20 +17,22 @@
 //    the more constrained: fixed or carrying extra mass (an anchor, a bead) before a boundary
 //    vertex (the cut edge keeps its shape) before an interior one; on a tie the lower slot (so the
 //    result does not depend on visiting order). A collapse that would flip a triangle, break
-//    manifoldness (link condition), pinch the surface, or create an angle smaller than the one it
-//    removes is refused and the next spring is tried.
+//    manifoldness (link condition), pinch the surface, create an angle below the limit or move a
+//    spring below min_spring_mm is refused and the next spring is tried.
 //  - Everything not removed keeps its handle; the removed vertex's handle goes stale (like
 //    removed material: an attachment on it breaks). Rest area and mass are exact (see
 //    Surface::collapse_edge): the removed triangles' rest area goes to their neighbours.
-//  - A cap (apex almost on its longest spring) none of whose springs can be collapsed is flipped
-//    (split the longest spring at the apex's foot, collapse the foot into the apex) when both new
-//    triangles are above the limit.
+//  - A cap (apex almost on its longest spring, every spring above min_spring_mm) none of whose
+//    springs can be collapsed is flipped (split the longest spring at the apex's foot, collapse the
+//    foot into the apex) when both new triangles are above the limit. A needle (a short spring) is
+//    not: flipping only moves the short spring on.
 //  - Last resort: the sliver is merged into the neighbour across its longest spring
 //    (Surface::dissolve_triangle: its rest area moves there, mass exact; the surface opens along
 //    it); a lone one-triangle fragment is removed as material, its mass reported in
 //    QualityResult::removed_mass_g.
 //  - A poor triangle nothing can fix is counted in `unresolved` and left as is (simulated; XPBD
-//    keeps it stable). The property tests assert the floor after every one of their operations.
+//    keeps it stable), as is one still poor when max_passes run out. The property tests assert
+//    the floor after every one of their operations.
 //
 // No allocation after construction; visits only the triangles around the vertices it is given.
 #include <cstdint>
