@@ -30,8 +30,6 @@ class SpringGroups {
   void reserve(const Surface& s);
   // Brings the groups up to date with the surface's springs, and marks which are active.
   void update(const Surface& s);
-  // The next update rebuilds from every spring (the surface's springs were replaced wholesale).
-  void invalidate() { built_ = false; }
 
   // Calls f(spring) for every spring of an active group, in sweep order.
   template <class F>
