@@ -63,13 +63,14 @@ SceneMaterials default_materials() {
       {"density_g_per_mm3", "Michels, Wilkinson & Rice 1990 (thesis ch. 2.3.3): 1.0174 g/ml"},
       {"thickness_mm", "Michels et al. 1990: 0.1-0.3 mm, 0.25 mm mid-periphery"},
       {"membrane_modulus_pa_mm", "E ~ 20 kPa (Jones et al. 1992; Chen et al. 2010) x 0.25 mm"},
+      {"bending_modulus_un_mm", "Kirchhoff plate D = E t^3 / (12 (1 - nu^2)), nu = 1/3: 5000 x 0.25^2 x 3/32"},
       {"tear_strain", "Michels et al. 1990: retina tears at 35-55 % stretch"},
   };
   m.gel.name = "vitreous gel";
   m.gel.density_g_per_mm3 = 1.0053e-3;
   m.gel.thickness_mm = 2.5;
   m.gel.membrane_modulus_pa_mm = 50.0;
-  m.gel.direction_stiffness_ratio = 0.05;
+  m.gel.bending_modulus_un_mm = 29.3;
   m.gel.tear_strain = 0.8;
   m.gel.drag_pa_s_per_mm = 20.0;
   m.gel.entrained_fluid_mm = 1.0;
@@ -77,18 +78,20 @@ SceneMaterials default_materials() {
       {"density_g_per_mm3", "Michels et al. 1990: vitreous 1.0053-1.0089 g/ml"},
       {"thickness_mm", "layer represented by one shell = shell spacing"},
       {"membrane_modulus_pa_mm", "vitreous shear modulus 6-120 Pa (Nickerson et al. 2008; Sharif-Kashani 2011) x 2.5 mm, ~20 Pa"},
+      {"bending_modulus_un_mm", "Kirchhoff plate D = E t^3 / (12 (1 - nu^2)), nu = 1/3: 50 x 2.5^2 x 3/32"},
       {"tear_strain", "gel is cut, not torn: high so the vitrector decides"},
   };
   m.membrane.name = "fibrovascular membrane";
   m.membrane.density_g_per_mm3 = 1.05e-3;
   m.membrane.thickness_mm = 0.05;
   m.membrane.membrane_modulus_pa_mm = 10000.0;
-  m.membrane.direction_stiffness_ratio = 0.05;
+  m.membrane.bending_modulus_un_mm = 2.34;
   m.membrane.tear_strain = 0.6;
   m.sources["membrane"] = {
       {"density_g_per_mm3", "collagenous tissue ~1.05 g/ml"},
       {"thickness_mm", "epiretinal membranes 20-80 um (OCT, Wilkins et al. 1996)"},
       {"membrane_modulus_pa_mm", "ERM E ~ 0.2 MPa (Chen et al. 2010 range) x 0.05 mm"},
+      {"bending_modulus_un_mm", "Kirchhoff plate D = E t^3 / (12 (1 - nu^2)), nu = 1/3: 10000 x 0.05^2 x 3/32"},
       {"tear_strain", "stiffer and tougher than retina; estimate"},
   };
   return m;

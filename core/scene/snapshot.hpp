@@ -19,7 +19,7 @@
 
 namespace vitreo::core {
 
-inline constexpr std::uint32_t kSnapshotVersion = 3;  // 2: the solver's wake lengths; 3: sleep groups are derived, not stored
+inline constexpr std::uint32_t kSnapshotVersion = 4;  // 2: the solver's wake lengths; 3: sleep groups are derived, not stored; 4: warm-start forces and bending
 
 struct SnapshotInfo {
   std::uint32_t version = 0;

@@ -150,7 +150,7 @@ void material_io(IO& io, M& m) {
   io.pod(m.density_g_per_mm3);
   io.pod(m.thickness_mm);
   io.pod(m.membrane_modulus_pa_mm);
-  io.pod(m.direction_stiffness_ratio);
+  io.pod(m.bending_modulus_un_mm);
   io.pod(m.tear_strain);
   io.pod(m.drag_pa_s_per_mm);
   io.pod(m.internal_damping_s);
@@ -224,6 +224,8 @@ void WorldAccess::write_state(const TissueWorld& w, std::vector<std::uint8_t>& o
     o.vec(f.rest_len_);
     o.vec(f.stiffness_);
     o.vec(f.edge_traction_);
+    o.vec(f.bend_);
+    o.vec(f.bend_rest_);
     o.vec(f.edge_alive_);
     o.vec(f.edge_is_line_);
     o.vec(f.edge_generation_);
@@ -251,14 +253,13 @@ void WorldAccess::write_state(const TissueWorld& w, std::vector<std::uint8_t>& o
     o.vec(sc.current_area);
     o.vec(sc.contact_load);
     o.vec(sc.wall_touched);
+    o.vec(sc.momentum);
     o.vec(sc.block_was_awake);
     o.vec(sc.wake_request);
     o.vec(sc.block_max_speed2);
     o.vec(sc.block_sleep_serial);
     o.vec(sc.wake_key);
     o.vec(sc.wake_length);
-    o.vec(sc.lambda_distance);
-    o.vec(sc.lambda_direction);
   }
 
   o.pod(static_cast<std::uint64_t>(w.attachments_.size()));
@@ -277,7 +278,6 @@ void WorldAccess::write_state(const TissueWorld& w, std::vector<std::uint8_t>& o
     o.pod(static_cast<std::uint8_t>(a.intact));
     o.pod(a.last_force_un);
     o.pod(a.peak_force_un);
-    o.vec3(a.lambda);
   }
   o.pod(static_cast<std::uint64_t>(w.local_forces_.size()));
   for (const auto& lf : w.local_forces_) {
@@ -376,6 +376,8 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       in.vec(f.rest_len_);
       in.vec(f.stiffness_);
       in.vec(f.edge_traction_);
+      in.vec(f.bend_);
+      in.vec(f.bend_rest_);
       in.vec(f.edge_alive_);
       in.vec(f.edge_is_line_);
       in.vec(f.edge_generation_);
@@ -407,14 +409,13 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       in.fixed_vec(sc.current_area);
       in.fixed_vec(sc.contact_load);
       in.fixed_vec(sc.wall_touched);
+      in.fixed_vec(sc.momentum);
       in.fixed_vec(sc.block_was_awake);
       in.fixed_vec(sc.wake_request);
       in.fixed_vec(sc.block_max_speed2);
       in.fixed_vec(sc.block_sleep_serial);
       in.fixed_vec(sc.wake_key);
       in.fixed_vec(sc.wake_length);
-      in.fixed_vec(sc.lambda_distance);
-      in.fixed_vec(sc.lambda_direction);
     }
 
     if (in.pod_value<std::uint64_t>() != w.attachments_.size()) {
@@ -436,7 +437,6 @@ Status WorldAccess::read_state(TissueWorld& w, const std::uint8_t* data, std::si
       if (apply) a.intact = intact;
       in.pod(a.last_force_un);
       in.pod(a.peak_force_un);
-      in.vec3(a.lambda);
       if (!apply && in.ok() && (a.d.surface_a >= w.surfaces_.size() ||
                                 (a.d.surface_b != AttachmentDescription::kWorld && a.d.surface_b >= w.surfaces_.size()))) {
         return Status::error("snapshot: attachment refers to a missing surface");

@@ -13,7 +13,7 @@ void TissueMaterial::validate() const {
   // Documented stiffness range (retina ~5e3, epiretinal and fibrovascular membranes up to ~5e4);
   // the solver is stable over all of it at dt = 1 ms (tests/core).
   require_range(membrane_modulus_pa_mm, 0.0, 1e5, p + "membrane_modulus_pa_mm");
-  require_range(direction_stiffness_ratio, 0.0, 1.0, p + "direction_stiffness_ratio");
+  require_range(bending_modulus_un_mm, 0.0, 1e4, p + "bending_modulus_un_mm");
   if (!(tear_strain > 0.0)) throw InvalidArgument(p + "tear_strain must be > 0 (or infinity)");
   require_range(drag_pa_s_per_mm, 0.0, 1e3, p + "drag_pa_s_per_mm");
   require_range(internal_damping_s, 0.0, 1.0, p + "internal_damping_s");

@@ -13,16 +13,19 @@ struct TissueMaterial {
   double density_g_per_mm3 = 1.0174e-3;
   double thickness_mm = 0.25;
 
-  // In-plane elasticity as a 2-D membrane modulus E·t (Pa·mm = µN/mm). Springs get stiffness
-  // k = E·t · (adjacent rest area) / (rest length)², which reproduces this modulus (with Poisson
-  // ratio 1/3) on an equilateral triangulation (Van Gelder 1998; the thesis used the same
-  // area weighting after Wilhelms & Van Gelder 1997). Retina E ≈ 20 kPa → 5000 µN/mm at 0.25 mm.
+  // In-plane elasticity as a 2-D membrane modulus E·t (Pa·mm = µN/mm), with Poisson's ratio 1/3
+  // (what a network of springs can represent). Springs get their stiffness from the triangles'
+  // linear elasticity (Surface::triangle_spring_share): Van Gelder's k = E·t · (adjacent rest
+  // area) / (rest length)² on equilateral triangles (Van Gelder 1998; the thesis used the same
+  // area weighting after Wilhelms & Van Gelder 1997), corrected on other shapes so a uniform
+  // stretch stores the continuum's energy. Retina E ≈ 20 kPa → 5000 µN/mm at 0.25 mm.
   double membrane_modulus_pa_mm = 5000.0;
 
-  // The thesis' vector springs keep their rest direction as well as their length, which resists
-  // in-surface shear and out-of-surface bending. Stiffness of that direction term relative to the
-  // axial stiffness (0 switches it off).
-  double direction_stiffness_ratio = 0.02;
+  // Bending modulus D (flexural rigidity, µN·mm): resistance to curving the sheet, energy ½ D κ²
+  // per unit area for a curvature κ. For a homogeneous plate D = E t³ / (12 (1 − ν²)) (Kirchhoff);
+  // with the spring network's Poisson ratio of 1/3 that is membrane_modulus × t² / (32/3). Retina:
+  // 5000 µN/mm × (0.25 mm)² × 3/32 ≈ 29 µN·mm. 0 switches bending off (a chain, a string).
+  double bending_modulus_un_mm = 29.3;
 
   // Tearing: a spring stretched past this engineering strain splits (retina tears at 35–55 %
   // stretch, Michels et al. 1990). Infinity disables tearing.
@@ -49,9 +52,10 @@ struct TissueMaterial {
   // the ~2 mm patches that move together in surgery. Ignored above the fluid level (under gas).
   double entrained_fluid_mm = 1.5;
 
-  // Plasticity: above `plastic_yield_strain` the rest shape creeps toward the current shape at
-  // `plastic_rate_per_s`, so a membrane released after a pull stays roughly where it was left
-  // (surgeons' complaint about springing back, thesis ch. 3). Rate 0 disables it.
+  // Plasticity: above `plastic_yield_strain` (strain, and bend in radians across a spring) the rest
+  // lengths and curvatures creep toward the current shape at `plastic_rate_per_s`, so a membrane
+  // released after a pull stays roughly where it was left (surgeons' complaint about springing
+  // back, thesis ch. 3). Rate 0 disables it.
   double plastic_yield_strain = 0.05;
   double plastic_rate_per_s = 0.0;
 

@@ -15,6 +15,12 @@ namespace {
 // In a crossing, only this many radii of the axis beyond the crossing point count toward the depth
 // (a long oblique shaft must not fling the triangle by its far end).
 constexpr double kCrossingReachRadii = 3.0;
+// A triangle this close to a capsule gets a contact term for the substep (it may move that far
+// during the sweeps; instruments move ≤ 0.1 mm per 1 ms step).
+constexpr double kContactReach_mm = 0.05;
+// How deep the contact terms may let tissue into a capsule before the hard projection acts: their
+// stiffness keeps a few mN of contact within a few µm.
+constexpr double kContactSlack_mm = 0.02;
 }  // namespace
 
 double TissueWorld::local_pressure_on(std::uint32_t surface, std::uint32_t vertex) const {
@@ -129,29 +135,84 @@ Vec3 TissueWorld::grip_point(std::uint32_t grip) const {
   return g.d.bary[0] * s.position(tv[0]) + g.d.bary[1] * s.position(tv[1]) + g.d.bary[2] * s.position(tv[2]);
 }
 
-void TissueWorld::project_grips(double h, double fraction) {
-  const double h2 = h * h;
+// The point terms of a substep (stage_solve.cpp): intact attachments, active grips (their targets
+// interpolated from the jaws' pose at the start of the step to the end) and instrument contacts.
+// A contact term is made for each candidate triangle within reach of its capsule, linearised at the
+// substep's start: the closest points of the triangle and the axis (at the capsule's pose at the
+// end of the substep) give the point, the push direction and the axis point to keep the capsule's
+// radius from. Triangles the axis crosses are left to the hard projection (project_contacts).
+void TissueWorld::add_point_terms(double fraction) {
+  clear_point_terms();
+  for (std::uint32_t i = 0; i < attachments_.size(); ++i) {
+    const Attachment& at = attachments_[i];
+    if (!at.intact) continue;
+    PointTerm t{};
+    t.kind = PointKind::kAttachment;
+    t.owner = i;
+    t.k = at.d.stiffness_un_per_mm;
+    t.surface[0] = at.d.surface_a;
+    t.vertex[0] = at.a.index;
+    t.b[0] = 1.0;
+    t.count = 1;
+    if (at.d.surface_b == AttachmentDescription::kWorld) {
+      t.target = at.d.world_point_mm;
+    } else {
+      t.surface[1] = at.d.surface_b;
+      t.vertex[1] = at.b.index;
+      t.b[1] = -1.0;
+      t.count = 2;
+    }
+    add_point_term(t);
+  }
   for (std::uint32_t i = 0; i < grip_high_water_; ++i) {
-    Grip& g = grips_[i];
-    if (!g.active) continue;
-    Surface& s = *surfaces_[g.d.surface];
-    if (!s.triangle_alive(g.d.triangle.index)) continue;
-    auto view = s.solver_view();
-    const double* w = scratch_[g.d.surface].effective_inverse_mass.data();
-    const auto tv = view.tri_v[g.d.triangle.index];
-    const Vec3& b = g.d.bary;
-    const double wsum = w[tv[0]] * b[0] * b[0] + w[tv[1]] * b[1] * b[1] + w[tv[2]] * b[2] * b[2];
-    if (wsum == 0.0) continue;
-    const Vec3 target = g.previous_target + fraction * (g.d.target_mm - g.previous_target);
-    const Vec3 p = b[0] * view.x[tv[0]] + b[1] * view.x[tv[1]] + b[2] * view.x[tv[2]];
-    const double kh2 = g.d.stiffness_un_per_mm * h2;
-    const Vec3 dl = (target - p) * (kh2 / (wsum * kh2 + 1.0));
-    for (int k = 0; k < 3; ++k) view.x[tv[k]] += w[tv[k]] * b[k] * dl;
-    g.last_force_un = dl.norm() / h2;
-    g.peak_force_un = std::max(g.peak_force_un, g.last_force_un);
+    const Grip& g = grips_[i];
+    if (!g.active || !surfaces_[g.d.surface]->triangle_alive(g.d.triangle.index)) continue;
+    PointTerm t{};
+    t.kind = PointKind::kGrip;
+    t.owner = i;
+    t.k = g.d.stiffness_un_per_mm;
+    t.count = 3;
+    const auto tv = surfaces_[g.d.surface]->triangle_vertices(g.d.triangle.index);
+    for (std::uint32_t j = 0; j < 3; ++j) {
+      t.surface[j] = g.d.surface;
+      t.vertex[j] = tv[j];
+      t.b[j] = g.d.bary[static_cast<Eigen::Index>(j)];
+    }
+    t.target = g.previous_target + fraction * (g.d.target_mm - g.previous_target);
+    add_point_term(t);
+  }
+  for (const ContactCandidate& c : candidates_) {
+    const ColliderCapsule& cap = colliders_[c.collider];
+    const Vec3 a = cap.a0 + fraction * (cap.a1 - cap.a0);
+    const Vec3 b = cap.b0 + fraction * (cap.b1 - cap.b0);
+    const Surface& s = *surfaces_[c.surface];
+    const auto tv = s.triangle_vertices(c.triangle);
+    const Vec3 &x0 = s.position(tv[0]), &x1 = s.position(tv[1]), &x2 = s.position(tv[2]);
+    const auto st = contact::closest_segment_triangle(a, b, x0, x1, x2);
+    // Within reach: the triangle may move toward the capsule during the substep's sweeps.
+    if (st.crossing || !(st.distance > 1e-9) || st.distance > cap.radius_mm + kContactReach_mm) continue;
+    PointTerm t{};
+    t.kind = PointKind::kContact;
+    t.owner = c.collider;
+    t.k = settings_.contact_stiffness_un_per_mm;
+    t.count = 3;
+    for (std::uint32_t j = 0; j < 3; ++j) {
+      t.surface[j] = c.surface;
+      t.vertex[j] = tv[j];
+      t.b[j] = st.bary[static_cast<Eigen::Index>(j)];
+    }
+    t.normal = (st.on_triangle - st.on_segment) / st.distance;
+    t.target = st.on_segment;
+    t.offset = cap.radius_mm;
+    add_point_term(t);
   }
 }
 
+// The hard guarantee behind the contact terms: after the sweeps, any candidate triangle still
+// deeper inside a capsule than kContactSlack_mm, or crossed by its axis, is pushed out (the part
+// beyond the slack; crossed triangles back to the side the instrument came from), so an instrument
+// never passes through tissue however fast it moves. The push's force is added to the contact
+// force as the momentum it took (m Δx / h²).
 void TissueWorld::project_contacts(double h, double fraction) {
   const double inv_h2 = 1.0 / (h * h);
   const double share = 1.0 / settings_.substeps;  // forces are averaged over the substeps
@@ -176,7 +237,7 @@ void TissueWorld::project_contacts(double h, double fraction) {
     if (axis_d2 > reach * reach) continue;
 
     const auto st = contact::closest_segment_triangle(a, b, x0, x1, x2);
-    if (!st.crossing && st.distance >= r) continue;
+    if (!st.crossing && st.distance >= r - kContactSlack_mm) continue;
     Vec3 tri_n = (x1 - x0).cross(x2 - x0);
     const double tri_n_len = tri_n.norm();
     if (!(tri_n_len > 0.0)) continue;
@@ -185,7 +246,7 @@ void TissueWorld::project_contacts(double h, double fraction) {
     double depth;
     if (!st.crossing && st.distance > 1e-9) {
       n = (st.on_triangle - st.on_segment) / st.distance;
-      depth = r - st.distance;
+      depth = r - kContactSlack_mm - st.distance;
     } else {
       // The axis crosses the triangle: push it back to the side the instrument came from.
       n = -static_cast<double>(c.side) * tri_n;
@@ -207,6 +268,8 @@ void TissueWorld::project_contacts(double h, double fraction) {
     x0 += (w[tv[0]] * bc[0] * lambda) * n;
     x1 += (w[tv[1]] * bc[1] * lambda) * n;
     x2 += (w[tv[2]] * bc[2] * lambda) * n;
+    // Pushed by the instrument: no momentum carried into the next substep (see sweep_vertices).
+    for (const auto v : tv) scratch_[c.surface].momentum[v] = Scratch::kStartDamped;
     contact_force_[c.collider * surfaces_.size() + c.surface] -= n * (lambda * inv_h2 * share);
   }
 }

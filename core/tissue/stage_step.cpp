@@ -42,6 +42,7 @@ void TissueWorld::restore_rollback() {
 
 void TissueWorld::integrate_and_predict(double h) {
   const double offset = settings_.wall_offset_mm;
+  const double settle_keep = 1.0 / (1.0 + h * settings_.settling_damping_per_s);
   for (std::size_t si = 0; si < surfaces_.size(); ++si) {
     const Surface& s = *surfaces_[si];
     auto view = surfaces_[si]->solver_view();
@@ -63,13 +64,37 @@ void TissueWorld::integrate_and_predict(double h) {
       }
       // Implicit Euler with drag: (m + h c) v' = m v + h f, i.e. v' = (v + h a) / (1 + h c/m). It
       // damps any rate without reversing the velocity and gives the right terminal speed; the
-      // constraints then use the matching effective mass (see Scratch::effective_inverse_mass).
-      view.v[v] = (view.v[v] + h * sc.acceleration[v]) * sc.velocity_keep[v];
-      view.x[v] += h * view.v[v];
-      // A prediction through the wall stops on it (an inelastic contact, like the wall
-      // projection after the springs): the springs then work from where the tissue can be, and
-      // the pressure that pressed it there is taken by the wall (see compute_external_accelerations).
-      if (walled && wall_.project_inside(view.x[v], offset)) sc.wall_touched[v] = 1;
+      // solve uses the matching effective mass (see Scratch::effective_inverse_mass) and this
+      // inertial target x̃, which carries the external forces.
+      sc.target[v] = view.x[v] + (h * view.v[v] + (h * h) * sc.acceleration[v]) * sc.velocity_keep[v];
+      // The sweeps start from the motion continued: x + h v (see stage_solve.cpp for why not x̃).
+      // Where the last substep's sweeps confirmed it (momentum[v], set in update_velocities), not
+      // slowed by the fluid's drag, which the target carries: tissue in fluid moves at the speed
+      // its forces and the drag balance at, slowly changing, so the last velocity is the best
+      // guess of the next, and each substep's sweeps build on the last's instead of starting over
+      // (a sweep started from x + h v × the drag's factor lets a 20k retina strip stretch tens of
+      // times slower than the material and the fluid allow). The artificial settling damping does
+      // act here: a sweep far from converged stays near its start, so damping meant to stop motion
+      // must slow the start itself.
+      // A vertex whose springs are far stiffer than its inertia (kStartInertial, see
+      // sweep_vertices) starts from the target instead: one sweep nearly solves its own block, so
+      // the external forces' share does not soften it, and a stiff fragment moved as a whole by
+      // an outside force (suction drawing a shred of membrane into the vitrector) moves at its
+      // drag-limited speed rather than creeping by the fraction of inertia to stiffness a sweep
+      // started without that force would move it.
+      if (sc.momentum[v] == Scratch::kStartInertial) {
+        view.x[v] += settle_keep * (sc.target[v] - view.x[v]);
+      } else {
+        const double carried = sc.momentum[v] == Scratch::kStartCarried ? 1.0 : sc.velocity_keep[v];
+        view.x[v] += (h * settle_keep * carried) * view.v[v];
+      }
+      // A target through the wall stops on it (an inelastic contact, like the wall projection in
+      // the sweeps): the springs then work from where the tissue can be, and the pressure that
+      // pressed it there is taken by the wall (see compute_external_accelerations).
+      if (walled) {
+        wall_.project_inside(sc.target[v], offset);
+        if (wall_.project_inside(view.x[v], offset)) sc.wall_touched[v] = 1;
+      }
     });
   }
 }
@@ -88,6 +113,15 @@ bool TissueWorld::update_velocities(double h) {
       double& move2 = sc.block_max_move2[v / Surface::kSleepBlock];  // kinematic vertices move too
       move2 = std::max(move2, moved.squaredNorm());
       if (view.inverse_mass[v] == 0.0) return;
+      // Keep the momentum in the next start only while it helps (adaptive restart, O'Donoghue &
+      // Candès 2015, per vertex): where the sweeps carried the vertex at least as far along its
+      // last velocity as the drag alone would, the motion is real; where they pulled it back, the
+      // continued motion overshot, and an overshoot left in would feed an oscillation of the
+      // unconverged sweeps (stiff slivers after a cut shake themselves apart without this).
+      const Vec3& last = view.v[v];
+      if (sc.momentum[v] == Scratch::kStartCarried && moved.dot(last) < h * sc.velocity_keep[v] * last.squaredNorm()) {
+        sc.momentum[v] = Scratch::kStartDamped;
+      }
       view.v[v] = moved * inv_h;
       if (sc.wall_touched[v]) {
         sc.wall_touched[v] = 0;
@@ -239,26 +273,18 @@ StepReport TissueWorld::step(double dt_s) {
   const int substeps = settings_.substeps;
   const double h = dt_s / substeps;
   compute_external_accelerations(h);
-  pack_springs(h);
+  pack_terms(h);
   bool finite = true;
   for (int sub = 0; sub < substeps && finite; ++sub) {
+    const double fraction = static_cast<double>(sub + 1) / substeps;
     integrate_and_predict(h);
-    const bool accumulate = settings_.iterations > 1;
-    if (accumulate) {
-      for (auto& sc : scratch_) {
-        std::fill(sc.lambda_distance.begin(), sc.lambda_distance.end(), 0.0);
-        std::fill(sc.lambda_direction.begin(), sc.lambda_direction.end(), Vec3::Zero());
-      }
-    }
-    for (auto& at : attachments_) at.lambda = Vec3::Zero();
+    add_point_terms(fraction);
     for (int it = 0; it < settings_.iterations; ++it) {
-      for (std::uint32_t si = 0; si < surfaces_.size(); ++si) project_springs(si, accumulate);
-      project_attachments(h, accumulate);
-      const double fraction = static_cast<double>(sub + 1) / substeps;
-      project_grips(h, fraction);
+      begin_sweep();
+      sweep_vertices(h);
       project_contacts(h, fraction);
-      project_wall();
     }
+    measure_point_forces(1.0 / substeps);
     finite = update_velocities(h);
   }
 

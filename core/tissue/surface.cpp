@@ -5,6 +5,8 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/LU>
+
 #include "core/common/prefault.hpp"
 #include "core/common/validate.hpp"
 
@@ -41,15 +43,16 @@ Surface::Surface(const SurfaceDescription& d)
   auto reserve_all = [](std::uint32_t n, auto&... vecs) { (vecs.reserve(n), ...); };
   reserve_all(vcap, x_, v_, rest_, mass_, inverse_mass_, extra_mass_, vertex_area_, vertex_alive_, fixed_,
               vertex_generation_, first_corner_, free_vertices_);
-  reserve_all(ecap, edge_v_, edge_t_, base_rest_vec_, rest_vec_, rest_len_, stiffness_, edge_traction_, edge_alive_,
-              edge_is_line_, edge_generation_, free_edges_);
+  reserve_all(ecap, edge_v_, edge_t_, base_rest_vec_, rest_vec_, rest_len_, stiffness_, edge_traction_, bend_, bend_rest_,
+              edge_alive_, edge_is_line_, edge_generation_, free_edges_);
   reserve_all(tcap, tri_v_, tri_e_, tri_rest_area_, tri_alive_, tri_generation_, free_triangles_);
   next_corner_.reserve(3 * static_cast<std::size_t>(tcap));
   // Touch the reserved memory now, so that a cut taking new slots during the simulation does not
   // pay the operating system's first-touch page faults (tens of µs per stroke otherwise).
   touch_reserved(x_, v_, rest_, mass_, inverse_mass_, extra_mass_, vertex_area_, vertex_alive_, fixed_,
                  vertex_generation_, first_corner_, free_vertices_, edge_v_, edge_t_, base_rest_vec_, rest_vec_,
-                 rest_len_, stiffness_, edge_traction_, edge_alive_, edge_is_line_, edge_generation_, free_edges_,
+                 rest_len_, stiffness_, edge_traction_, bend_, bend_rest_, edge_alive_,
+                 edge_is_line_, edge_generation_, free_edges_,
                  tri_v_, tri_e_, tri_rest_area_, tri_alive_, tri_generation_, free_triangles_, next_corner_);
   block_awake_.assign((vcap + kSleepBlock - 1) / kSleepBlock, 1);
   block_quiet_steps_.assign(block_awake_.size(), 0);
@@ -171,6 +174,8 @@ std::uint32_t Surface::allocate_edge() {
     rest_len_.push_back(0.0);
     stiffness_.push_back(0.0);
     edge_traction_.push_back(1.0);
+    bend_.emplace_back();
+    bend_rest_.push_back(0.0);
     edge_alive_.push_back(0);
     edge_is_line_.push_back(0);
     edge_generation_.push_back(0);
@@ -178,6 +183,8 @@ std::uint32_t Surface::allocate_edge() {
   edge_t_[e] = {kNone, kNone};
   edge_alive_[e] = 1;
   edge_is_line_[e] = 0;
+  bend_[e] = BendStencil{};
+  bend_rest_[e] = 0.0;
   ++live_edges_;
   ++topology_version_;
   return e;
@@ -209,6 +216,7 @@ void Surface::free_edge(std::uint32_t e) {
   edge_alive_[e] = 0;
   log_spring(e);
   stiffness_[e] = 0.0;
+  bend_[e] = BendStencil{};
   ++edge_generation_[e];
   free_edges_.push_back(e);
   --live_edges_;
@@ -334,13 +342,100 @@ void Surface::update_vertex_mass(std::uint32_t v) {
 
 void Surface::update_edge_stiffness(std::uint32_t e) {
   if (!edge_alive_[e] || edge_is_line_[e]) return;
-  double area = 0.0;
-  for (auto t : edge_t_[e]) {
-    if (t != kNone) area += tri_rest_area_[t];
-  }
   const double len2 = base_rest_vec_[e].squaredNorm();
-  // Van Gelder's area weighting (see material.hpp); a boundary edge carries one triangle's share.
-  stiffness_[e] = len2 > 0.0 ? material_.membrane_modulus_pa_mm * area / len2 : 0.0;
+  double k = 0.0;
+  for (const auto t : edge_t_[e]) {
+    if (t != kNone && len2 > 0.0) k += triangle_spring_share(t, e) / len2;
+  }
+  stiffness_[e] = k;
+  update_edge_bending(e);
+}
+
+// A triangle's share of the stiffness of its spring e (µN/mm × mm²: divided by the spring's rest
+// length² by the caller).
+//
+// In linear elasticity a triangle's energy is a quadratic form in the strains of its three edges,
+// W = ½ δᵀ G δ, δ_k = Δℓ_k / ℓ_k (the strain tensor is fixed by the three edge strains: δ_k =
+// t_kᵀ ε t_k, t_k the edge's direction), with G = M⁻ᵀ C M⁻¹, C the plane-stress stiffness of the
+// membrane (modulus E·t, Poisson ratio 1/3) times the rest area and M the map from the strain
+// tensor to the edge strains. Springs carry the diagonal only. Each spring takes its row of G,
+// summed (k_k ℓ_k² = Σ_l G_kl): a uniform expansion of any triangle then stores exactly its
+// elastic energy (a pressurised membrane inflates as a continuum would, however the mesh is
+// shaped), and on an equilateral triangle — where G is diagonal for ν = 1/3 — it is Van Gelder's
+// k = E·t × area / ℓ² (Van Gelder 1998), which gives the network the modulus E·t and Poisson's
+// ratio 1/3 (Lloyd, Székely & Harders 2007 discuss why no spring network matches other ratios).
+// A very obtuse triangle can make a row negative; a spring's share is kept above a tenth of Van
+// Gelder's, so a spring never pushes its ends apart when stretched.
+double Surface::triangle_spring_share(std::uint32_t t, std::uint32_t e) const {
+  const auto& te = tri_e_[t];
+  // The triangle's edge directions in its own plane (rest vectors, any orientation: only t tᵀ
+  // enters).
+  std::array<Vec3, 3> r{base_rest_vec_[te[0]], base_rest_vec_[te[1]], base_rest_vec_[te[2]]};
+  const Vec3 ex = r[0].normalized();
+  const Vec3 ez = r[0].cross(r[1]).normalized();
+  const Vec3 ey = ez.cross(ex);
+  Eigen::Matrix3d m;
+  for (int k = 0; k < 3; ++k) {
+    const double len = r[static_cast<std::size_t>(k)].norm();
+    const double cx = r[static_cast<std::size_t>(k)].dot(ex) / len, cy = r[static_cast<std::size_t>(k)].dot(ey) / len;
+    m.row(k) << cx * cx, cy * cy, 2.0 * cx * cy;  // δ_k = t_kᵀ ε t_k with ε = (εxx, εyy, εxy)
+  }
+  const double nu = 1.0 / 3.0;
+  const double et = material_.membrane_modulus_pa_mm * tri_rest_area_[t];
+  const double lambda = et * nu / (1.0 - nu * nu), mu = et / (2.0 * (1.0 + nu));
+  Eigen::Matrix3d c;
+  c << lambda + 2.0 * mu, lambda, 0.0, lambda, lambda + 2.0 * mu, 0.0, 0.0, 0.0, 4.0 * mu;
+  const Eigen::Matrix3d m_inverse = m.inverse();
+  const Eigen::Matrix3d g = m_inverse.transpose() * c * m_inverse;
+  int k = 0;
+  while (k < 3 && te[static_cast<std::size_t>(k)] != e) ++k;
+  if (k == 3) return 0.0;
+  const double van_gelder = et;  // × ℓ² / ℓ²
+  return std::max(g.row(k).sum(), 0.1 * van_gelder);
+}
+
+Vec3 Surface::rest_vector_between(std::uint32_t t, std::uint32_t from, std::uint32_t to) const {
+  for (const std::uint32_t e : tri_e_[t]) {
+    if (e == kNone) continue;
+    const auto ev = edge_v_[e];
+    if (ev[0] == from && ev[1] == to) return rest_vec_[e];
+    if (ev[0] == to && ev[1] == from) return -rest_vec_[e];
+  }
+  return Vec3::Zero();
+}
+
+void Surface::update_edge_bending(std::uint32_t e) {
+  bend_[e] = BendStencil{};
+  bend_rest_[e] = 0.0;
+  const auto [t0, t1] = edge_t_[e];
+  if (t0 == kNone || t1 == kNone || !(material_.bending_modulus_un_mm > 0.0)) return;
+  const auto [a, b] = edge_v_[e];
+  const auto [c, d] = edge_opposite_vertices(e);
+  // The stencil's rest shape, from the springs' rest vectors (positions relative to a).
+  const Vec3 xb = rest_vec_[e];  // rest vectors run from edge_v_[e][0] = a
+  const Vec3 xc = rest_vector_between(t0, a, c);
+  const Vec3 xd = rest_vector_between(t1, a, d);
+  const Vec3 e0 = xb, e1 = xc, e2 = xd, e3 = xc - xb, e4 = xd - xb;
+  // Cotangents of the four angles at a and b, bounded so a rest sliver cannot give a huge weight
+  // (the topology layer keeps rest angles above 1°, cot 57).
+  auto cot = [](const Vec3& u, const Vec3& v) {
+    const double s = u.cross(v).norm();
+    return std::clamp(u.dot(v) / std::max(s, 1e-300), -100.0, 100.0);
+  };
+  const double c01 = cot(e0, e1), c02 = cot(e0, e2), c03 = cot(-e0, e3), c04 = cot(-e0, e4);
+  BendStencil& st = bend_[e];
+  st.K = {c03 + c04, c01 + c02, -c01 - c03, -c02 - c04};
+  st.stiffness = material_.bending_modulus_un_mm / (tri_rest_area_[t0] + tri_rest_area_[t1]);
+  bool a_then_b = false;  // does triangle 0 run a → b?
+  for (std::size_t k = 0; k < 3; ++k) a_then_b |= tri_v_[t0][k] == a && tri_v_[t0][(k + 1) % 3] == b;
+  st.orientation = a_then_b ? 1.0 : -1.0;
+  const Vec3 xa = Vec3::Zero();
+  bend_rest_[e] = st.curvature(xa, xb, xc, xd).dot(st.normal(xa, xb, xc, xd));
+}
+
+double Surface::edge_force(std::uint32_t e) const {
+  const auto [a, b] = edge_v_[e];
+  return stiffness_[e] * ((x_[b] - x_[a]).norm() - rest_len_[e]);
 }
 
 double Surface::edge_strain(std::uint32_t e) const {
@@ -434,21 +529,32 @@ void Surface::apply_plasticity(double dt_s, double floor_mm, std::vector<std::ui
   for (std::uint32_t e = 0; e < edge_slots(); ++e) {
     if (!edge_alive_[e]) continue;
     const auto [a, b] = edge_v_[e];
-    const Vec3 d = x_[b] - x_[a];
-    const double scale = surface_traction_ * edge_traction_[e];
-    const Vec3 current_base = d / scale;  // what the base rest vector would have to be to be at rest
-    const Vec3 diff = current_base - base_rest_vec_[e];
+    if (!vertex_awake(a) && !vertex_awake(b)) continue;  // asleep: nothing changed
+    // Length: the rest length creeps by the part of the strain beyond the yield, so small elastic
+    // deformations still spring back; the rest vector keeps its direction.
+    const double length = (x_[b] - x_[a]).norm();
     const double base_len = base_rest_vec_[e].norm();
-    if (diff.norm() <= yield * base_len) continue;
-    // Creep only by the part beyond the yield, so small elastic deformations still spring back.
-    const Vec3 excess = diff * (1.0 - yield * base_len / diff.norm());
-    base_rest_vec_[e] += alpha * excess;
-    const double before = rest_len_[e];
-    refresh_rest(e);
-    if (crept_short && before >= floor_mm && rest_len_[e] < floor_mm && crept_short->size() + 2 <= crept_short->capacity()) {
-      crept_short->push_back(a);
-      crept_short->push_back(b);
+    const double scale = surface_traction_ * edge_traction_[e];
+    const double strain = base_len > 0.0 ? length / (scale * base_len) - 1.0 : 0.0;
+    if (std::abs(strain) > yield) {
+      const double excess = strain - std::copysign(yield, strain);
+      base_rest_vec_[e] *= 1.0 + alpha * excess;
+      const double before = rest_len_[e];
+      refresh_rest(e);
+      if (crept_short && before >= floor_mm && rest_len_[e] < floor_mm && crept_short->size() + 2 <= crept_short->capacity()) {
+        crept_short->push_back(a);
+        crept_short->push_back(b);
+      }
     }
+    // Curvature: beyond a bend of `yield` radians across the spring (h ≈ θ × the spring's length
+    // for this stencil), the rest curvature creeps toward the current one.
+    const BendStencil& st = bend_[e];
+    if (st.stiffness == 0.0) continue;
+    const auto [c, d] = edge_opposite_vertices(e);
+    const double h = st.curvature(x_[a], x_[b], x_[c], x_[d]).dot(st.normal(x_[a], x_[b], x_[c], x_[d]));
+    const double diff = h - bend_rest_[e];
+    const double allowed = yield * rest_len_[e];
+    if (std::abs(diff) > allowed) bend_rest_[e] += alpha * (diff - std::copysign(allowed, diff));
   }
 }
 

@@ -7,9 +7,16 @@
 // That keeps allocation out of the physics step. Vertex data is stored as parallel arrays in mesh
 // order (the order of the generating rings), which is the order the solver sweeps.
 //
-// The model is the thesis' (ch. 2.3): springs that keep a rest length *and* a rest direction ("vector
-// springs"), stiffness weighted by adjacent rest area, vertex mass from adjacent rest area, so total
-// mass is conserved when triangles are subdivided and drops in proportion to removed area.
+// The model: springs along the triangles' edges keep their rest length (stiffness weighted by the
+// adjacent rest area, so a triangulation reproduces the membrane modulus — the thesis' ch. 2.3 after
+// Wilhelms & Van Gelder; a triangle's three springs also hold its in-plane shape, so shear is
+// resisted without any direction in the world frame), bending stencils across interior springs keep
+// the rest curvature (see BendStencil), and vertex mass comes from the adjacent rest area, so total
+// mass is conserved when triangles are subdivided and drops in proportion to removed area. Every
+// elastic term depends only on lengths and curvatures: turning the tissue rigidly stores no energy.
+// Springs still carry a rest *vector* (the thesis' vector springs): the rest shape, which new
+// springs inherit by vector addition when topology changes (see below) and from which the rest
+// curvature is measured; its direction in the world plays no part in the forces.
 #include <array>
 #include <cstdint>
 #include <span>
@@ -100,6 +107,46 @@ class Surface {
   std::array<std::uint32_t, 2> edge_triangles(std::uint32_t e) const { return edge_t_[e]; }
   // Rest length including traction scaling.
   double edge_rest_length(std::uint32_t e) const { return rest_len_[e]; }
+  // Tension of the spring now (µN, positive when stretched).
+  double edge_force(std::uint32_t e) const;
+  // Bending across an interior spring (one shared by two triangles): the stencil of the spring's
+  // ends and the two opposite vertices, after the quadratic bending model of Bergou, Wardetzky,
+  // Harmon, Zorin & Grinspun 2006 ("A quadratic bending model for inextensible surfaces").
+  // The curvature vector of the stencil, H = Σ K_i x_i, is held at `rest_curvature` along the
+  // stencil's normal with stiffness D / (A_0 + A_1) (D = material bending modulus, A the rest areas
+  // of the two triangles): energy ½ k |H − h₀ n̂|², which is rotation invariant (H turns with the
+  // tissue, and so does n̂) and equals ½ D (κ₁ + κ₂)² per unit area on smooth bending
+  // (tests/core/bending_test.cpp checks it against a cylinder and a sphere).
+  struct BendStencil {
+    std::array<double, 4> K{};   // weights of a, b (the spring's ends), c, d (opposite in its triangles 0, 1)
+    double stiffness = 0.0;      // µN/mm; 0 for boundary and line springs
+    double orientation = 1.0;    // +1 when triangle 0 runs a → b, else −1 (see normal)
+    // The stencil's unit normal: the sum of its two triangles' area-weighted normals, which for a
+    // consistently oriented mesh is ±(b − a) × (c − d) (zero when degenerate).
+    Vec3 normal(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) const {
+      const Vec3 n = (b - a).cross(c - d) * orientation;
+      const double len = n.norm();
+      return len > 0.0 ? Vec3(n / len) : Vec3::Zero();
+    }
+    // The curvature vector H = Σ K_i x_i.
+    Vec3 curvature(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) const {
+      return K[0] * a + K[1] * b + K[2] * c + K[3] * d;
+    }
+  };
+  const BendStencil& edge_bend(std::uint32_t e) const { return bend_[e]; }
+  // h₀: the stencil's curvature vector at rest, along its normal (mm; signed by the triangles'
+  // orientation). Taken from the rest vectors when the spring's triangles change; plasticity
+  // creeps it toward the current shape. State (snapshots keep it).
+  double edge_rest_curvature(std::uint32_t e) const { return bend_rest_[e]; }
+  // The vertices opposite spring e in its two triangles (kNone where it has no such triangle).
+  std::array<std::uint32_t, 2> edge_opposite_vertices(std::uint32_t e) const {
+    std::array<std::uint32_t, 2> o{kNone, kNone};
+    for (std::size_t i = 0; i < 2; ++i) {
+      const std::uint32_t t = edge_t_[e][i];
+      if (t != kNone) o[i] = tri_v_[t][0] + tri_v_[t][1] + tri_v_[t][2] - edge_v_[e][0] - edge_v_[e][1];
+    }
+    return o;
+  }
   const Vec3& edge_rest_vector(std::uint32_t e) const { return rest_vec_[e]; }
   double edge_stiffness(std::uint32_t e) const { return stiffness_[e]; }
   double edge_strain(std::uint32_t e) const;
@@ -291,8 +338,10 @@ class Surface {
   struct SolverView;
   SolverView solver_view();
 
-  // Plastic flow: rest vectors creep toward the current edge vectors where the strain exceeds the
-  // material's yield. Called by the solver once per step. With `crept_short`, the two ends of each
+  // Plastic flow, where the deformation exceeds the material's yield: rest lengths creep toward the
+  // current lengths (the rest vector keeps its direction) and rest curvatures toward the current
+  // curvatures, so a membrane released after a pull or a fold stays roughly where it was left.
+  // Both measures are rotation invariant. Called by the solver once per step. With `crept_short`, the two ends of each
   // spring whose rest length crept from at least `floor_mm` to below it this step are appended
   // (while the list has capacity: nothing allocates), so the topology layer can tidy there.
   void apply_plasticity(double dt_s, double floor_mm = 0.0, std::vector<std::uint32_t>* crept_short = nullptr);
@@ -322,7 +371,9 @@ class Surface {
 
   // Recomputes mass and inverse mass of vertex v from its adjacent rest area.
   void update_vertex_mass(std::uint32_t v);
-  // Recomputes the stiffness of triangle edge e from its adjacent rest areas (line springs keep theirs).
+  // Recomputes the stiffness of triangle edge e from its adjacent rest areas (line springs keep
+  // theirs), and its bending stencil from the rest shape of its two triangles (rest curvature
+  // included; the bending force starts again from zero).
   void update_edge_stiffness(std::uint32_t e);
 
  private:
@@ -339,6 +390,10 @@ class Surface {
   void attach_triangle_to_edge(std::uint32_t e, std::uint32_t t);
   void detach_triangle_from_edge(std::uint32_t e, std::uint32_t t);
   void refresh_rest(std::uint32_t e);
+  void update_edge_bending(std::uint32_t e);
+  double triangle_spring_share(std::uint32_t t, std::uint32_t e) const;
+  // The rest vector of triangle t's spring from vertex `from` to vertex `to` (zero if none).
+  Vec3 rest_vector_between(std::uint32_t t, std::uint32_t from, std::uint32_t to) const;
   std::uint32_t separate_fans(std::uint32_t v, std::vector<std::uint32_t>* copies = nullptr);
   void free_vertex(std::uint32_t v);
   // Notes for the batched recomputation (see EditBatch): v's triangles changed; e's triangles
@@ -378,6 +433,8 @@ class Surface {
   std::vector<std::array<std::uint32_t, 2>> edge_v_, edge_t_;
   std::vector<Vec3> base_rest_vec_, rest_vec_;
   std::vector<double> rest_len_, stiffness_, edge_traction_;
+  std::vector<BendStencil> bend_;     // derived from the rest shape (update_edge_stiffness)
+  std::vector<double> bend_rest_;     // state: h₀ (plasticity moves it)
   std::vector<std::uint8_t> edge_alive_, edge_is_line_;
   std::vector<std::uint32_t> edge_generation_, free_edges_;
   std::uint32_t live_edges_ = 0;
@@ -417,7 +474,10 @@ struct Surface::SolverView {
   std::span<const std::array<std::uint32_t, 2>> edge_v;
   std::span<const Vec3> rest_vec;
   std::span<const double> rest_len, stiffness;
+  std::span<const BendStencil> bend;
+  std::span<const double> bend_rest;
   std::span<const std::uint8_t> edge_alive;
+  std::span<const std::array<std::uint32_t, 2>> edge_t;
   std::span<const std::array<std::uint32_t, 3>> tri_v;
   std::span<const std::uint8_t> tri_alive;
   std::span<const double> vertex_area;  // lumped rest area per vertex (for drag and local forces)
@@ -425,8 +485,8 @@ struct Surface::SolverView {
 
 // Inline: the solver takes views in its per-attachment and per-stage loops.
 inline Surface::SolverView Surface::solver_view() {
-  return SolverView{x_, v_, inverse_mass_, vertex_alive_, edge_v_, rest_vec_, rest_len_, stiffness_, edge_alive_,
-                    tri_v_, tri_alive_, vertex_area_};
+  return SolverView{x_,     v_,         inverse_mass_, vertex_alive_, edge_v_, rest_vec_, rest_len_, stiffness_,
+                    bend_,  bend_rest_, edge_alive_,   edge_t_,       tri_v_,  tri_alive_, vertex_area_};
 }
 
 }  // namespace vitreo::core

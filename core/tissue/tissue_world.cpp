@@ -33,6 +33,7 @@ void SolverSettings::validate() const {
   require_range(sleep_speed_mm_s, 0.0, 100.0, "solver: sleep_speed_mm_s");
   if (sleep_after_steps < 1 || sleep_after_steps > 60000) throw InvalidArgument("solver: sleep_after_steps must be in [1, 60000]");
   require_range(wake_strain, 1e-6, 1.0, "solver: wake_strain");
+  require_range(contact_stiffness_un_per_mm, 1e2, 1e8, "solver: contact_stiffness_un_per_mm");
 }
 
 TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings settings)
@@ -47,6 +48,17 @@ TissueWorld::TissueWorld(GlobeWall wall, Environment environment, SolverSettings
   suction_.reserve(kMaxSuctionFields);
   contact_depth_.assign(kMaxColliders, 0.0);
   grips_.resize(kMaxGrips);
+  reserve_point_terms();
+}
+
+// Room for every attachment, grip and contact term of a substep (grown while building, by
+// doubling; the step never allocates).
+void TissueWorld::reserve_point_terms() {
+  const std::size_t terms = attachments_.size() + kMaxGrips + kMaxContactTerms;
+  if (point_terms_.capacity() >= terms) return;
+  point_terms_.reserve(2 * terms);
+  point_refs_.reserve(6 * terms);
+  point_vertices_.reserve(6 * terms);
 }
 
 std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
@@ -65,6 +77,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.current_area.resize(cap);
   s.contact_load.resize(cap);
   s.wall_touched.resize(cap);
+  s.momentum.assign(cap, 0);
   const std::size_t blocks = surface->block_count();
   s.block_was_awake.assign(blocks, 0);
   s.wake_request.assign(blocks, 0);
@@ -75,9 +88,16 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.wake_key.assign(surface->edge_capacity(), ~std::uint64_t{0});
   s.wake_length.assign(surface->edge_capacity(), 0.0);
   s.groups.reserve(*surface);
-  s.springs.resize(surface->edge_capacity());
-  s.lambda_distance.resize(surface->edge_capacity());
-  s.lambda_direction.resize(surface->edge_capacity());
+  s.active.resize(cap);
+  s.slot.assign(cap, kNone);
+  s.spring_begin.resize(cap + 1);
+  s.stencil_begin.resize(cap + 1);
+  s.fill.resize(cap + 1);
+  s.spring_terms.resize(2 * std::size_t{surface->edge_capacity()});
+  s.stencil_refs.resize(4 * std::size_t{surface->edge_capacity()});
+  s.stencils.resize(surface->edge_capacity());
+  s.target.resize(cap);
+  s.point_head.assign(cap, kNone);
   surfaces_.push_back(std::move(surface));
   hooks_.push_back(nullptr);
   scratch_.push_back(std::move(s));
@@ -94,7 +114,7 @@ std::uint32_t TissueWorld::add_attachment(const AttachmentDescription& d) {
   if (d.surface_a >= surfaces_.size()) throw InvalidArgument("attachment: surface_a out of range");
   const Surface& sa = *surfaces_[d.surface_a];
   if (!sa.vertex_alive(d.vertex_a)) throw InvalidArgument("attachment: vertex_a is not a live vertex");
-  Attachment a{d, sa.vertex_id(d.vertex_a), {}, true, 0.0, 0.0, Vec3::Zero()};
+  Attachment a{d, sa.vertex_id(d.vertex_a), {}, true, 0.0, 0.0};
   if (d.surface_b == AttachmentDescription::kWorld) {
     require_finite(d.world_point_mm, "attachment: world point");
   } else {
@@ -109,6 +129,7 @@ std::uint32_t TissueWorld::add_attachment(const AttachmentDescription& d) {
     throw InvalidArgument("attachment: break force must be > 0 (infinity = unbreakable)");
   }
   attachments_.push_back(a);
+  reserve_point_terms();
   return static_cast<std::uint32_t>(attachments_.size() - 1);
 }
 
@@ -205,14 +226,17 @@ Energy TissueWorld::energy() const {
       en.kinetic += 0.5 * s.mass(v) * s.velocity(v).squaredNorm();
       en.gravity -= s.mass(v) * buoyant * environment_.gravity_mm_s2.dot(s.position(v));
     }
-    const double ratio = s.material().direction_stiffness_ratio;
     for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
       if (!s.edge_alive(e)) continue;
       const auto [a, b] = s.edge_vertices(e);
-      const Vec3 d = s.position(b) - s.position(a);
-      const double k = s.edge_stiffness(e);
-      const double stretch = d.norm() - s.edge_rest_length(e);
-      en.elastic += 0.5 * k * stretch * stretch + 0.5 * ratio * k * (d - s.edge_rest_vector(e)).squaredNorm();
+      const double stretch = (s.position(b) - s.position(a)).norm() - s.edge_rest_length(e);
+      en.elastic += 0.5 * s.edge_stiffness(e) * stretch * stretch;
+      const Surface::BendStencil& st = s.edge_bend(e);
+      if (st.stiffness == 0.0) continue;
+      const auto [c, d] = s.edge_opposite_vertices(e);
+      const Vec3 &xa = s.position(a), &xb = s.position(b), &xc = s.position(c), &xd = s.position(d);
+      const Vec3 off = st.curvature(xa, xb, xc, xd) - s.edge_rest_curvature(e) * st.normal(xa, xb, xc, xd);
+      en.elastic += 0.5 * st.stiffness * off.squaredNorm();
     }
   }
   for (const auto& at : attachments_) {
@@ -260,6 +284,7 @@ std::uint64_t TissueWorld::state_hash() const {
       const auto ev = s.edge_vertices(e);
       h.add_u64((std::uint64_t{ev[0]} << 32) | ev[1]);
       h.add_vec3(s.edge_rest_vector(e));
+      h.add_double(s.edge_rest_curvature(e));
     }
     h.add_u64(s.triangle_slots());
   }

@@ -7,10 +7,15 @@
 // rate with dt as a parameter. The world owns no clock and no thread; two worlds built and stepped
 // the same way end in the same bits (state_hash()).
 //
-// The solver is XPBD (Macklin, Müller & Chentanez 2016) with several substeps of one iteration each
-// ("Small Steps", Macklin et al. 2019): compliance makes stiffness independent of step size and
-// iteration count, and small substeps keep it stable at dt = 1 ms for every stiffness in the
-// material range, and when tiny triangles appear after a cut.
+// The solver is implicit Euler solved by Vertex Block Descent (Chen, Liu, Yang & Yuksel 2024): each
+// substep minimises the incremental potential ½|x − x̃|²_M/h² + E(x) by Gauss–Seidel sweeps over the
+// vertices, each vertex taking one Newton step on its own energy with its neighbours held. The
+// sweeps start from where inertia alone would carry the tissue (x + h v, without this substep's
+// external forces), so tissue at rest is already the minimiser and a sweep leaves it there: the
+// solver's fixed point is the exact equilibrium of the nominal material for any number of substeps
+// and sweeps. Sweeps that do not converge leave the tissue slow (damped), never soft; an XPBD sweep
+// started from the prediction x̃ settles many times softer than the material instead
+// (core/README.md, "The solver", has the argument and the measurements).
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -47,6 +52,11 @@ struct Environment {
 struct SolverSettings {
   int substeps = 2;    // per step, 1..64
   int iterations = 1;  // constraint sweeps per substep, 1..64
+  // Instrument contact: the tissue is kept out of an instrument by a stiff one-sided spring
+  // (µN/mm; 2e5 lets 1 mN of contact force press 5 µm in), whose force is the contact force the
+  // metrics report; a hard projection after the sweeps catches what a fast instrument would still
+  // push through (stage_instruments.cpp).
+  double contact_stiffness_un_per_mm = 2e5;
   int max_tears_per_step = 8;
   double wall_offset_mm = 0.0;  // tissue keeps this distance inside the wall
   // Mass-proportional velocity damping (1/s) on top of fluid drag: used to settle a case to
@@ -55,7 +65,7 @@ struct SolverSettings {
   // Sleeping (see Surface::kSleepBlock): a block whose vertices all stay below sleep_speed for
   // sleep_after_steps consecutive steps stops being simulated until something wakes it.
   bool sleeping = true;
-  double sleep_speed_mm_s = 0.2;
+  double sleep_speed_mm_s = 0.01;
   int sleep_after_steps = 200;
   // A sleeping vertex wakes when the strain of a spring from an awake neighbour has changed by more
   // than this since its block fell asleep (a change of pull, not the tension it rests under).
@@ -186,6 +196,9 @@ class TissueWorld {
   static constexpr std::uint32_t kMaxContactCandidates = 32768;
   static constexpr std::uint32_t kMaxGrips = 4096;
   static constexpr std::uint32_t kMaxSuctionFields = 4;
+  // Triangles an instrument presses on in one substep (contact terms of the solve; beyond this the
+  // hard projection alone keeps the tissue out).
+  static constexpr std::uint32_t kMaxContactTerms = 8192;
   // Colliders and candidates for the next step (copied; extra entries beyond capacity are refused).
   Status set_colliders(std::span<const ColliderCapsule> colliders);
   Status set_contact_candidates(std::span<const ContactCandidate> candidates);
@@ -257,25 +270,55 @@ class TissueWorld {
     bool intact = true;
     double last_force_un = 0.0;
     double peak_force_un = 0.0;
-    Vec3 lambda = Vec3::Zero();  // accumulated over the iterations of a substep
   };
   struct LocalForce {
     LocalForceDescription d;
   };
-  // One spring as the sweep sees it during a step (built each step by pack_springs, in sweep
-  // order). Only springs with at least one movable end are packed.
-  struct SolverSpring {
-    std::uint32_t a, b;        // end vertices
-    std::uint32_t edge;        // for the multipliers of the accumulating (iterations > 1) sweep
-    std::uint32_t wake_block;  // 1 + the block of a sleeping end (the pull may wake it); 0: none
-    double wake_length;        // the spring's length when that block fell asleep
-    double wa, wb;             // effective inverse masses of the ends (constant within a step)
-    Vec3 rest_vec;
+
+  // ---- What the vertex sweep reads (built by pack_terms once per step; stage_solve.cpp) -------
+  // A spring as seen from one of its movable ends (each spring appears once per movable end).
+  struct SpringTerm {
+    std::uint32_t other;       // the vertex at the far end
+    std::uint32_t wake_block;  // 1 + the block of a sleeping far end (the pull may wake it); 0: none
+    double k;                  // µN/mm
     double rest_len;
-    double kh2;            // k h²
-    double kth;            // k τ h (the dashpot)
-    double inverse_denominator;  // 1 / ((wa + wb)(k h² + k τ h) + 1), the distance term's XPBD gain
-    double direction_gain; // the capped gain of the rest-direction term (single-iteration sweeps)
+    double damping;            // k τ / h: the dashpot's coefficient over a substep
+    double wake_length;        // the spring's length when that block fell asleep
+  };
+  // A bending stencil (Surface::BendStencil) with its curvature vector kept current through the
+  // sweep: every vertex update adds K_i Δx_i, so a vertex reads H instead of four positions.
+  struct Stencil {
+    std::array<std::uint32_t, 4> v;  // a, b (the spring's ends), c, d (opposite vertices)
+    std::array<double, 4> K;
+    double k;       // µN/mm
+    Vec3 target;    // h₀ n̂: the rest curvature along this step's stencil normal
+    Vec3 h;         // Σ K_i x_i, current within the sweep
+  };
+  struct StencilRef {
+    std::uint32_t stencil;
+    std::uint32_t corner;  // 0..3
+  };
+  // A point p = Σ b_j x_j of up to three vertices (of any surfaces) held to a target: an
+  // attachment (isotropic, p = x_a − x_b, target 0, or x_a to a world point), a grip (the
+  // barycentric point of a triangle to the jaws) or a contact (one-sided: n·(p − target) ≥ offset,
+  // the tissue kept out of an instrument capsule).
+  enum class PointKind : std::uint8_t { kAttachment, kGrip, kContact };
+  struct PointTerm {
+    PointKind kind;
+    std::uint8_t count;
+    std::uint32_t owner;                        // attachment, grip or collider index
+    std::array<std::uint32_t, 3> surface{}, vertex{};
+    std::array<double, 3> b{};
+    Vec3 target = Vec3::Zero();
+    Vec3 normal = Vec3::Zero();                 // contacts: the push direction
+    double offset = 0.0;                        // contacts: the capsule radius
+    double k = 0.0;
+    Vec3 point(const TissueWorld& w) const;     // p with the current positions
+  };
+  struct PointRef {  // a vertex's share of a point term, in a per-vertex chain
+    std::uint32_t term;
+    std::uint32_t corner;
+    std::uint32_t next;
   };
   struct Scratch {  // per surface, sized to capacity once
     std::vector<Vec3> previous, acceleration, rollback_x, rollback_v;
@@ -297,6 +340,11 @@ class TissueWorld {
     // removed (an inelastic contact, as in the velocity pass of Müller et al. 2020) so it cannot
     // bounce between wall and springs from one substep to the next.
     std::vector<std::uint8_t> wall_touched;
+    // Where a vertex's next substep starts (see integrate_and_predict); state: it decides the next
+    // step. kStartCarried: its motion continued undamped; kStartDamped: continued with the fluid's
+    // drag; kStartInertial: the inertial target x̃ (springs far stiffer than its inertia).
+    static constexpr std::uint8_t kStartDamped = 0, kStartCarried = 1, kStartInertial = 2;
+    std::vector<std::uint8_t> momentum;  // kStart* (see integrate_and_predict)
 
     // Sleeping bookkeeping, per vertex block.
     std::vector<std::uint8_t> block_was_awake;  // awake during the previous step
@@ -316,15 +364,20 @@ class TissueWorld {
     // Springs grouped by sleep block, so a sweep can skip whole groups that touch only sleeping
     // blocks (spring_groups.hpp). Derived from the topology, not state.
     SpringGroups groups;
-    // The springs this step's sweeps project, in sweep order, with everything that is constant
-    // within a step gathered next to them (see pack_springs): the sweep reads one contiguous array
-    // instead of five edge arrays through an index, and skips no spring at run time.
-    std::vector<SolverSpring> springs;
-    std::uint32_t spring_count = 0;
-    // Constraint multipliers accumulated over the iterations of one substep (only with
-    // iterations > 1; a single iteration starts every constraint from zero).
-    std::vector<double> lambda_distance;
-    std::vector<Vec3> lambda_direction;
+    // The vertex sweep's input (pack_terms): the movable vertices of awake blocks in sweep
+    // (mesh) order, and for each its springs and stencils, contiguous (CSR: the terms of
+    // active[i] are [spring_begin[i], spring_begin[i + 1]) and likewise for stencils).
+    std::vector<std::uint32_t> active;
+    std::uint32_t active_count = 0;
+    std::vector<std::uint32_t> slot;  // per vertex: its index in active, or kNone
+    std::vector<std::uint32_t> spring_begin, stencil_begin;
+    std::vector<SpringTerm> spring_terms;
+    std::vector<StencilRef> stencil_refs;
+    std::vector<Stencil> stencils;
+    std::uint32_t stencil_count = 0;
+    std::vector<std::uint32_t> fill;  // scratch for the CSR fill
+    std::vector<Vec3> target;         // the inertial target x̃ of the substep
+    std::vector<std::uint32_t> point_head;  // per vertex: its first PointRef, or kNone
   };
   struct TearCandidate {
     std::uint32_t surface;
@@ -332,18 +385,19 @@ class TissueWorld {
     double strain;
   };
 
-  // Stages of a step (one file each: stage_forces.cpp, stage_constraints.cpp, stage_step.cpp).
+  // Stages of a step (one file each: stage_forces.cpp, stage_solve.cpp, stage_instruments.cpp,
+  // stage_step.cpp).
   void compute_external_accelerations(double h);
   void integrate_and_predict(double h);
-  void pack_springs(double h);
-  void project_springs(std::uint32_t s, bool accumulate);
-  template <bool kAccumulate, bool kDirection>
-  void sweep_springs(std::uint32_t s);
-  void project_attachments(double h, bool accumulate);
-  void project_wall();
-  void project_grips(double h, double fraction);
+  void pack_terms(double h);
+  void add_point_terms(double fraction);
+  void add_point_term(const PointTerm& term);
+  void clear_point_terms();
+  void reserve_point_terms();
+  void begin_sweep();
+  void sweep_vertices(double h);
+  void measure_point_forces(double fraction_of_step);
   void project_contacts(double h, double fraction);
-  void apply_suction();
   void break_grips();
   void rebind_grips();
   bool update_velocities(double h);
@@ -388,6 +442,11 @@ class TissueWorld {
   std::vector<double> contact_depth_;   // kMaxColliders
   std::vector<Grip> grips_;
   std::uint32_t grip_high_water_ = 0;
+  // The point terms of the step (attachments and grips) and of the substep (contacts), and each
+  // vertex's chain of references to them (Scratch::point_head). Sized once.
+  std::vector<PointTerm> point_terms_;
+  std::vector<PointRef> point_refs_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> point_vertices_;  // (surface, vertex) with a chain
   std::uint64_t step_count_ = 0;
   double time_s_ = 0.0;
 };

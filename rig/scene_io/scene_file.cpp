@@ -192,7 +192,7 @@ const std::vector<std::pair<const char*, double core::TissueMaterial::*>>& mater
       {"density_g_per_mm3", &M::density_g_per_mm3},
       {"thickness_mm", &M::thickness_mm},
       {"membrane_modulus_pa_mm", &M::membrane_modulus_pa_mm},
-      {"direction_stiffness_ratio", &M::direction_stiffness_ratio},
+      {"bending_modulus_un_mm", &M::bending_modulus_un_mm},
       {"tear_strain", &M::tear_strain},
       {"drag_pa_s_per_mm", &M::drag_pa_s_per_mm},
       {"internal_damping_s", &M::internal_damping_s},

@@ -62,7 +62,7 @@ TEST(SolverBehaviour, ASpringTearsAtTheConfiguredStrain) {
     SurfaceDescription d;
     d.mesh = test::rectangle(6.0, 1.0, 12, 2);
     d.material.tear_strain = tear;
-    d.material.direction_stiffness_ratio = 0.0;
+    d.material.bending_modulus_un_mm = 0.0;
     d.contained_by_globe = false;
     Environment env;
     env.gravity_mm_s2 = Vec3::Zero();
@@ -82,16 +82,13 @@ TEST(SolverBehaviour, ASpringTearsAtTheConfiguredStrain) {
         pulled.push_back(v);
       }
     }
-    // Pull the right edge slowly (quasi-static: 6 mm/s) and watch the largest strain.
+    // Pull the right edge slowly (quasi-static: 6 mm/s) and watch the largest strain at the end
+    // of each step (where tears are decided).
     double strain_before_tear = 0.0;
     double torn_at = -1.0;
     for (int i = 0; i < 4000 && torn_at < 0; ++i) {
       for (auto v : pulled) {
         ASSERT_TRUE(s.set_fixed_position(s.vertex_id(v), s.position(v) + Vec3(0.006, 0, 0)));
-      }
-      double max_strain = 0.0;
-      for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
-        if (s.edge_alive(e)) max_strain = std::max(max_strain, s.edge_strain(e));
       }
       const auto r = world.step(1e-3);
       ASSERT_TRUE(r.ok);
@@ -99,7 +96,9 @@ TEST(SolverBehaviour, ASpringTearsAtTheConfiguredStrain) {
         torn_at = world.events().front().magnitude;
         EXPECT_EQ(world.events().front().kind, TissueEventKind::kTear);
       } else {
-        strain_before_tear = max_strain;
+        for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+          if (s.edge_alive(e)) strain_before_tear = std::max(strain_before_tear, s.edge_strain(e));
+        }
       }
     }
     ASSERT_GT(torn_at, 0.0) << "no tear for tear_strain " << tear;
@@ -260,7 +259,7 @@ TEST(SolverBehaviour, RestingTissueSleepsAndWakesWhenPulled) {
   // An attached retina with no detachment comes to rest and sleeps; moving the optic-disc anchors
   // wakes the tissue around them, and the result matches a run without sleeping.
   struct Outcome {
-    std::uint32_t awake_before = 0, awake_after = 0;
+    std::uint32_t awake_before = 0, awake_during = 0;
     Vec3 start = Vec3::Zero(), end = Vec3::Zero();
   };
   auto run = [](bool sleeping) {
@@ -301,9 +300,9 @@ TEST(SolverBehaviour, RestingTissueSleepsAndWakesWhenPulled) {
         }
       }
       EXPECT_TRUE(scene.world.step(1e-3).ok);
+      out.awake_during = std::max(out.awake_during, scene.world.awake_blocks());
     }
     for (int i = 0; i < 200; ++i) EXPECT_TRUE(scene.world.step(1e-3).ok);
-    out.awake_after = scene.world.awake_blocks();
     out.end = s.position(watched);
     return out;
   };
@@ -311,12 +310,14 @@ TEST(SolverBehaviour, RestingTissueSleepsAndWakesWhenPulled) {
   const Outcome reference = run(false);
   const std::uint32_t blocks = (static_cast<std::uint32_t>(small_retina().retina_vertices) + 63) / 64;
   EXPECT_LE(sleeping.awake_before, blocks / 20) << "a retina at rest on the choroid should (almost all) sleep";
-  EXPECT_GT(sleeping.awake_after, 0u) << "pulling the anchors must wake the tissue around them";
+  EXPECT_GT(sleeping.awake_during, sleeping.awake_before) << "pulling the anchors must wake the tissue around them";
   // Intraocular pressure holds the attached retina on the wall (the wall takes the pressure only
   // as far as the springs leave it to), so the lift stretches the tissue by the disc more than it
-  // lifts it: ~0.03 mm of motion, and sleeping must reproduce it to a third of that.
-  EXPECT_GT((reference.end - reference.start).norm(), 0.02) << "the pull moved the tissue next to the disc";
-  EXPECT_LT((sleeping.end - reference.end).norm(), 0.01) << "sleeping must not change the outcome";
+  // lifts it: ~0.02 mm of motion at the retina's nominal stiffness, and sleeping must reproduce it
+  // to a third of that.
+  const double moved = (reference.end - reference.start).norm();
+  EXPECT_GT(moved, 0.015) << "the pull moved the tissue next to the disc";
+  EXPECT_LT((sleeping.end - reference.end).norm(), moved / 3.0) << "sleeping must not change the outcome";
 }
 
 TEST(SolverBehaviour, TinyTrianglesStayStable) {
@@ -379,20 +380,27 @@ TEST(SolverBehaviour, PlasticityKeepsAReleasedMembraneNearWhereItWasLeft) {
     d.mesh = test::rectangle(4.0, 4.0, 8, 8);
     d.material.plastic_rate_per_s = plastic_rate;
     d.material.tear_strain = INFINITY;
+    // In a thin fluid (1/20 of vitreous' drag, no entrained mass), so that bending alone returns
+    // the elastic sheet within the test's seconds: a 4 mm cantilever relaxes with τ ≈ c L⁴ /
+    // (3.5² D) ≈ 0.7 s here, ~14 s in vitreous.
+    d.material.drag_pa_s_per_mm = 1.0;
+    d.material.entrained_fluid_mm = 0.0;
     d.contained_by_globe = false;
     Environment env;
     env.gravity_mm_s2 = Vec3::Zero();
     env.apply_pressure = false;
     TissueWorld world(far_wall(), env);
     Surface& s = world.surface(world.add_surface(d));
+    // Clamped (two columns held, so the sheet cannot simply hinge about its edge: a rigid turn
+    // stores no energy and would stay).
     for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-      if (s.rest_position(v).x() == 0.0) {
+      if (s.rest_position(v).x() <= 0.5 + 1e-9) {
         EXPECT_TRUE(s.set_fixed(s.vertex_id(v), true));
       }
     }
     const std::uint32_t grip = 4 * 9 + 8;  // middle of the free edge (row 4, column 8)
     EXPECT_TRUE(s.set_fixed(s.vertex_id(grip), true));
-    // Lift the free edge's middle 2 mm out of plane over 1 s, hold 1 s, release, wait 1 s.
+    // Lift the free edge's middle 2 mm out of plane over 1 s, hold 1 s, release, wait 3 s.
     bool ok = true;
     for (int i = 0; i < 1000; ++i) {
       ok &= s.set_fixed_position(s.vertex_id(grip), s.rest_position(grip) + Vec3(0, 0, 2.0 * (i + 1) / 1000)).is_ok();
@@ -400,11 +408,11 @@ TEST(SolverBehaviour, PlasticityKeepsAReleasedMembraneNearWhereItWasLeft) {
     }
     for (int i = 0; i < 1000; ++i) ok &= world.step(1e-3).ok;
     ok &= s.set_fixed(s.vertex_id(grip), false).is_ok();
-    for (int i = 0; i < 1000; ++i) ok &= world.step(1e-3).ok;
+    for (int i = 0; i < 3000; ++i) ok &= world.step(1e-3).ok;
     EXPECT_TRUE(ok);
     return s.position(grip).z();
   };
   const double elastic = run(0.0), plastic = run(5.0);
-  EXPECT_LT(elastic, 0.5) << "without plasticity the membrane springs back";
+  EXPECT_LT(elastic, 0.3) << "without plasticity the membrane springs back";
   EXPECT_GT(plastic, 1.0) << "with plasticity it stays roughly where it was left";
 }

@@ -39,14 +39,14 @@ void BM_TissueStep(benchmark::State& state) {
   // Warm-up: the detachment lifts and settles; the attached retina goes to sleep.
   for (int i = 0; i < 1000; ++i) world.step(1e-3);
 
-  std::size_t edges = 0, vertices = 0;
-  double direction_terms = 0.0;
+  std::size_t edges = 0, vertices = 0, bends = 0;
   for (std::uint32_t s = 0; s < world.surface_count(); ++s) {
-    edges += world.surface(s).edge_count();
-    vertices += world.surface(s).vertex_count();
-    if (world.surface(s).material().direction_stiffness_ratio > 0.0) direction_terms += world.surface(s).edge_count();
+    const Surface& surface = world.surface(s);
+    edges += surface.edge_count();
+    vertices += surface.vertex_count();
+    for (std::uint32_t e = 0; e < surface.edge_slots(); ++e) bends += surface.edge_alive(e) && surface.edge_bend(e).stiffness > 0.0;
   }
-  const double per_sweep = static_cast<double>(edges) + direction_terms + world.attachment_count() + static_cast<double>(vertices);
+  const double per_sweep = static_cast<double>(edges + bends) + world.attachment_count() + static_cast<double>(vertices);
   const double projections_per_step = per_sweep * world.settings().substeps * world.settings().iterations;
 
   std::vector<double> samples;

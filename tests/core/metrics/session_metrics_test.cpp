@@ -23,7 +23,7 @@ SurfaceDescription sheet(double size, int cells, double z) {
   d.mesh = test::rectangle(size, size, cells, cells);
   for (auto& p : d.mesh.positions) p += Vec3(-size / 2, -size / 2, z);
   d.contained_by_globe = false;
-  d.material.membrane_modulus_pa_mm = 1e5;  // stiff enough that the force grows with the depth
+  d.material.membrane_modulus_pa_mm = 1e4;  // the stiffest shipped material (membrane.toml: ERM)
   d.material.tear_strain = INFINITY;
   return d;
 }
@@ -172,10 +172,19 @@ TEST(SessionMetrics, TimeAboveTheDamageLimitIsCounted) {
   EXPECT_DOUBLE_EQ(m.totals().time_over_force_limit_s, over * kDt);
   EXPECT_NEAR(m.totals().time_over_force_limit_s, (s.first + s.second) * kDt, 2.5 * kDt);
   EXPECT_EQ(m.totals().force_limit_un, 300.0);
-  // With the instruments' own limit (3000 µN) the same script never damages the sheet.
+  // With the instruments' own limit (3000 µN) the same press made at a surgeon's speed (5 mm/s
+  // down, held, back up) never damages the sheet. (The script's 1.3 mm jump in one step is an
+  // impact: at the sheet's nominal stiffness its first milliseconds exceed 3000 µN.)
   Bench b2;
   SessionMetrics m2(b2.world, b2.metrics_case(), b2.instruments.get());
-  run_contacts(b2, m2, s);
+  double held = 0.0;
+  for (int i = 0; i <= 260; ++i) step_and_observe(b2, m2, Vec3(0.0, 0.0, 1.0 - 0.005 * i));
+  for (int i = 0; i < s.first; ++i) {
+    step_and_observe(b2, m2, down);
+    held = b2.instruments->instrument(0).retina_force_un;
+  }
+  for (int i = 260; i >= 0; --i) step_and_observe(b2, m2, Vec3(0.0, 0.0, 1.0 - 0.005 * i));
+  EXPECT_GT(held, o.retina_force_limit_un) << "the held press must be a real load";
   EXPECT_EQ(m2.totals().force_limit_un, b2.instruments->options().retina_force_limit_un);
   EXPECT_EQ(m2.totals().time_over_force_limit_s, 0.0);
   EXPECT_EQ(m2.totals().count(InstrumentEventKind::kExcessiveRetinaForce), 0u);

@@ -1,9 +1,11 @@
 // Surface::EditBatch: edits made inside a batch recompute masses and stiffnesses once, at its end.
 // The result must be the same, bit for bit, as the same edits made one at a time, and both must
 // match the definitions (mass = areal density × adjacent rest area / 3 + extra mass; stiffness =
-// membrane modulus × adjacent rest area / |base rest vector|², Van Gelder), computed here from
-// the public topology without the Surface's own update functions.
+// the constant-strain triangle's energy lumped on its springs, see stiffness_by_definition), computed
+// here from the public topology without the Surface's own update functions.
 #include <gtest/gtest.h>
+
+#include <Eigen/Dense>
 
 #include <cstdint>
 #include <random>
@@ -61,13 +63,62 @@ double mass_by_definition(const Surface& s, std::uint32_t v) {
   return s.material().areal_density_g_per_mm2() * area + s.extra_mass(v);
 }
 
+// The linear-elastic energy of a triangle (membrane modulus E·t, Poisson ratio 1/3, plane stress)
+// whose rest edge lengths are `rest` and whose edges are stretched to `rest × (1 + strain)`: the
+// triangle laid out in its plane from its lengths, F from the edge vectors, Green strain.
+double triangle_energy(double et, const std::array<double, 3>& rest, const std::array<double, 3>& strain) {
+  const auto layout = [](double a, double b, double c) {  // edges 0 = p0p1 (a), 1 = p1p2 (b), 2 = p2p0 (c)
+    const double x = (a * a + c * c - b * b) / (2.0 * a);
+    Eigen::Matrix2d d;
+    d << a, x, 0.0, std::sqrt(std::max(c * c - x * x, 0.0));
+    return d;  // columns p1 − p0, p2 − p0
+  };
+  const Eigen::Matrix2d dm = layout(rest[0], rest[1], rest[2]);
+  const Eigen::Matrix2d ds =
+      layout(rest[0] * (1 + strain[0]), rest[1] * (1 + strain[1]), rest[2] * (1 + strain[2]));
+  const Eigen::Matrix2d f = ds * dm.inverse();
+  const Eigen::Matrix2d green = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  const double area = 0.5 * dm.determinant();
+  const double nu = 1.0 / 3.0, lambda = et * nu / (1.0 - nu * nu), mu = et / (2.0 * (1.0 + nu));
+  return area * (0.5 * lambda * green.trace() * green.trace() + mu * (green * green).trace());
+}
+
+// Whether a triangle's three rest lengths make a triangle of its rest area (Heron): edits that
+// re-home springs (collapses) can leave rest vectors that do not close, where "the triangle's
+// continuum energy" has no single meaning and only the batch identity is checked.
+bool rest_shape_closes(const Surface& s, std::uint32_t t) {
+  const auto te = s.triangle_edges(t);
+  const double a = s.edge_rest_vector(te[0]).norm(), b = s.edge_rest_vector(te[1]).norm(),
+               c = s.edge_rest_vector(te[2]).norm(), p = 0.5 * (a + b + c);
+  const double heron = std::sqrt(std::max(0.0, p * (p - a) * (p - b) * (p - c)));
+  return std::abs(heron - s.triangle_rest_area(t)) <= 1e-9 * s.triangle_rest_area(t);
+}
+
+// A spring's stiffness by the definition in surface.cpp (triangle_spring_share), computed another
+// way: each triangle gives the spring k ℓ² = ∂W/∂δ at a uniform small stretch δ = (s, s, s), by
+// central differences of the triangle's continuum energy, at least a tenth of Van Gelder's E·t·A.
 double stiffness_by_definition(const Surface& s, std::uint32_t e) {
-  double area = 0.0;
+  const double et = s.material().membrane_modulus_pa_mm;
+  const double len2 = s.edge_rest_vector(e).squaredNorm();  // traction stays 1: the base rest vector
+  double k = 0.0;
   for (auto t : s.edge_triangles(e)) {
-    if (t != kNone) area += s.triangle_rest_area(t);
+    if (t == kNone) continue;
+    const auto te = s.triangle_edges(t);
+    std::array<double, 3> rest{};
+    std::size_t which = 0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      rest[i] = s.edge_rest_vector(te[i]).norm();
+      if (te[i] == e) which = i;
+    }
+    const double u = 1e-4, eps = 1e-6;
+    std::array<double, 3> plus{u, u, u}, minus{u, u, u};
+    plus[which] += eps;
+    minus[which] -= eps;
+    const double row = (triangle_energy(et, rest, plus) - triangle_energy(et, rest, minus)) / (2.0 * eps * u);
+    k += std::max(row, 0.1 * et * s.triangle_rest_area(t)) / len2;
+
   }
-  // Traction stays 1 here, so the rest vector is the base rest vector.
-  return s.material().membrane_modulus_pa_mm * area / s.edge_rest_vector(e).squaredNorm();
+  return k;
 }
 
 }  // namespace
@@ -101,13 +152,19 @@ TEST(EditBatch, EditsInABatchEndExactlyAsTheSameEditsOneAtATime) {
       EXPECT_EQ(batched.vertex_rest_area(v), one_by_one.vertex_rest_area(v)) << "seed " << seed << " vertex " << v;
       EXPECT_NEAR(batched.mass(v), mass_by_definition(batched, v), 1e-12 * batched.mass(v)) << "vertex " << v;
     }
+    std::uint32_t checked = 0;
     for (std::uint32_t e = 0; e < batched.edge_slots(); ++e) {
       ASSERT_EQ(batched.edge_alive(e), one_by_one.edge_alive(e));
       if (!batched.edge_alive(e)) continue;
       EXPECT_EQ(batched.edge_stiffness(e), one_by_one.edge_stiffness(e)) << "seed " << seed << " spring " << e;
-      EXPECT_NEAR(batched.edge_stiffness(e), stiffness_by_definition(batched, e), 1e-9 * batched.edge_stiffness(e))
+      bool closes = true;
+      for (auto t : batched.edge_triangles(e)) closes = closes && (t == kNone || rest_shape_closes(batched, t));
+      if (!closes) continue;
+      ++checked;
+      EXPECT_NEAR(batched.edge_stiffness(e), stiffness_by_definition(batched, e), 1e-3 * batched.edge_stiffness(e))
           << "seed " << seed << " spring " << e;
     }
+    EXPECT_GT(checked, batched.edge_count() * 3 / 4) << "seed " << seed << ": most springs keep a closed rest shape";
     const auto report = check_surface(batched, ValidityLimits{});
     EXPECT_TRUE(report.ok()) << "seed " << seed << ": " << report.summary();
   }
