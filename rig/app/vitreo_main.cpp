@@ -305,6 +305,7 @@ int main(int argc, char** argv) {
     std::printf("  telemetry        %llu messages (%llu dropped) → %s\n",
                 static_cast<unsigned long long>(s.telemetry_published), static_cast<unsigned long long>(s.telemetry_dropped),
                 config.lcm_url.c_str());
+    for (const auto& line : s.receive_lines) std::printf("  received         %s\n", line.c_str());
     std::printf("  recording        %s\n", config.record_path.c_str());
     for (const auto& line : s.snapshots) std::printf("  snapshot         %s\n", line.c_str());
     if (render) {

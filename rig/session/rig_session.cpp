@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <algorithm>
@@ -168,7 +169,9 @@ SessionSummary run_session(const SessionConfig& config) {
   telemetry::TelemetryPublisher publisher(telemetry::PublisherConfig{config.lcm_url, 4096});
   telemetry::TelemetrySource& physics_out = publisher.add_source("physics");
   telemetry::TelemetrySource& devices_out = publisher.add_source("devices");
-  telemetry::CommandServer commands(publisher.lcm());
+  // Malformed packets on the command channel are counted in the publisher's receive statistics
+  // (VITREO_RECEIVE_STATUS) and never reach the server.
+  telemetry::CommandServer commands(publisher.lcm(), 64, &publisher.receive_stats().channel(telemetry::kChanCommand));
 
   std::string snapshot_dir = config.snapshot_dir;
   if (snapshot_dir.empty()) {
@@ -304,10 +307,15 @@ SessionSummary run_session(const SessionConfig& config) {
     }
   });
   loop = &harness.loop();
+  std::int64_t next_receive_status_ns = 0;
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();
     publisher.handle_incoming();
     commands.pump_local();  // commands typed on the terminal: the same validation and queue
+    if (const std::int64_t now = wall.now_ns(); now >= next_receive_status_ns) {  // 1 Hz (CHANNELS.md)
+      publisher.publish_receive_status("vitreo");
+      next_receive_status_ns = now + 1'000'000'000;
+    }
   });
   if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
   harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(!harness.physics_done()); });
@@ -336,6 +344,7 @@ SessionSummary run_session(const SessionConfig& config) {
   hub.stop();
   if (recorder) recorder->close();
   publisher.pump();
+  publisher.publish_receive_status("vitreo");  // the session's last word on what it received
   if (renderer) {
     render_latest();  // the final state, so the last frame shows where the session ended
     renderer->stop();
@@ -364,6 +373,14 @@ SessionSummary run_session(const SessionConfig& config) {
   if (recorder) {
     summary.inputs_recorded = recorder->written();
     summary.recorder_dropped = recorder->dropped();
+  }
+  for (const auto& row : publisher.receive_stats().snapshot()) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%-16s %llu received, %llu refused as malformed, %llu handler errors%s%s", row.channel.c_str(),
+                  static_cast<unsigned long long>(row.received), static_cast<unsigned long long>(row.rejected),
+                  static_cast<unsigned long long>(row.handler_errors), row.last_error.empty() ? "" : " (last: ",
+                  row.last_error.empty() ? "" : (row.last_error + ")").c_str());
+    summary.receive_lines.emplace_back(line);
   }
   summary.telemetry_published = publisher.published();
   summary.telemetry_dropped = publisher.dropped();
@@ -405,7 +422,16 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
   // as the header's duration says when present, else through the last input.
   std::uint64_t total = rec.inputs.empty() ? 0 : static_cast<std::uint64_t>(rec.inputs.back().step) + 1;
   for (const auto& in : rec.inputs) {
-    if (in.device_kind == kSessionEndKind && in.n_values >= 1) total = static_cast<std::uint64_t>(in.values[0]);
+    if (in.device_kind != kSessionEndKind) continue;
+    // Recorded at the session's last step with the number of steps run: anything else (NaN, 1e12, a
+    // count that disagrees with its own step) is a damaged recording, not a length to run for.
+    const double n = in.n_values >= 1 ? in.values[0] : std::nan("");
+    if (!(n == static_cast<double>(in.step + 1)) || in.step < 0) {
+      throw std::runtime_error(path + ": the session-end marker at step " + std::to_string(in.step) +
+                               " says the session ran " + fmt::format("{}", n) + " steps (expected " +
+                               std::to_string(in.step + 1) + "): the recording is damaged");
+    }
+    total = static_cast<std::uint64_t>(in.step) + 1;
   }
   runtime::SimulatedClock sim;
   runtime::SteadyClock wall;

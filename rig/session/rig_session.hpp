@@ -62,6 +62,7 @@ struct SessionSummary {
   std::uint64_t inputs_applied = 0, inputs_refused = 0, inputs_recorded = 0, recorder_dropped = 0;
   std::uint64_t tears = 0, attachments_broken = 0, rolled_back = 0;
   std::uint64_t telemetry_published = 0, telemetry_dropped = 0;
+  std::vector<std::string> receive_lines;  // per subscribed LCM channel: received, refused, handler errors
   std::uint64_t state_hash = 0;
   std::vector<std::string> device_lines;  // per device: name, link statistics
   std::uint64_t instrument_events = 0;     // grasps, contacts, collisions, burns… (telemetry VITREO_EVENT)

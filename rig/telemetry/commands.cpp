@@ -147,12 +147,9 @@ Verdict validate_command(const vitreo_lcm::operator_command_t& cmd, const Comman
   return Verdict{true, {}};
 }
 
-CommandServer::CommandServer(lcm::LCM& lcm, std::size_t queue_capacity) : lcm_(lcm), queue_(queue_capacity) {
-  sub_ = subscribe_to<vitreo_lcm::operator_command_t>(lcm_, kChanCommand, &dispatch_);
-}
-
-CommandServer::~CommandServer() {
-  if (sub_) lcm_.unsubscribe(sub_);
+CommandServer::CommandServer(lcm::LCM& lcm, std::size_t queue_capacity, ChannelCounters* counters)
+    : lcm_(lcm), queue_(queue_capacity) {
+  sub_ = subscribe_to<vitreo_lcm::operator_command_t>(lcm_, kChanCommand, &dispatch_, counters);
 }
 
 void CommandServer::pump_local() {
@@ -175,19 +172,45 @@ void CommandServer::pump_local() {
   }
 }
 
+namespace {
+// A source names a sender in acks and logs: short printable ASCII, so a crafted one cannot forge log
+// lines or grow without bound.
+bool valid_source(const std::string& s) {
+  if (s.empty() || s.size() > CommandServer::kMaxSourceLength) return false;
+  for (char c : s) {
+    if (c < 0x21 || c > 0x7e) return false;
+  }
+  return true;
+}
+}  // namespace
+
 Verdict CommandServer::handle(const vitreo_lcm::operator_command_t& command) {
   const vitreo_lcm::operator_command_t* cmd = &command;
   Verdict v;
   auto last = last_seq_.find(cmd->source);
   if (cmd->source.empty()) {
     v = {false, "command has no source"};
-  } else if (last != last_seq_.end() && cmd->seq <= last->second) {
-    v = {false, "sequence " + std::to_string(cmd->seq) + " is not after " + std::to_string(last->second) +
+  } else if (!valid_source(cmd->source)) {
+    v = {false, "source must be 1-" + std::to_string(kMaxSourceLength) + " printable ASCII characters without spaces"};
+  } else if (cmd->arg.size() > kMaxArgLength) {
+    v = {false, "argument longer than " + std::to_string(kMaxArgLength) + " characters"};
+  } else if (last != last_seq_.end() && cmd->seq <= last->second.seq) {
+    v = {false, "sequence " + std::to_string(cmd->seq) + " is not after " + std::to_string(last->second.seq) +
                     " from '" + cmd->source + "' (duplicate or reordered)"};
   } else {
     v = validate_command(*cmd, context_.read());
   }
-  if (!cmd->source.empty() && (last == last_seq_.end() || cmd->seq > last->second)) last_seq_[cmd->source] = cmd->seq;
+  if (valid_source(cmd->source) && (last == last_seq_.end() || cmd->seq > last->second.seq)) {
+    if (last == last_seq_.end() && last_seq_.size() >= kMaxSources) {
+      // Forget the source heard from least recently: the map stays bounded whatever a sender invents.
+      auto oldest = last_seq_.begin();
+      for (auto it = last_seq_.begin(); it != last_seq_.end(); ++it) {
+        if (it->second.heard < oldest->second.heard) oldest = it;
+      }
+      last_seq_.erase(oldest);
+    }
+    last_seq_[cmd->source] = SourceState{cmd->seq, ++heard_};
+  }
 
   if (v.accepted) {
     AcceptedCommand a;
@@ -202,18 +225,19 @@ Verdict CommandServer::handle(const vitreo_lcm::operator_command_t& command) {
   }
   vitreo_lcm::command_ack_t ack;
   ack.utime_us = wall_time_us();
-  ack.source = cmd->source;
+  ack.source = cmd->source.substr(0, 256);  // echoed so the sender can match it; a valid one is short
   ack.seq = cmd->seq;
   ack.command = cmd->command;
   ack.accepted = v.accepted;
   ack.reason = v.reason;
   lcm_.publish(kChanCommandAck, &ack);
+  const std::string who = valid_source(cmd->source) ? cmd->source : std::string("(invalid source)");
   if (v.accepted) {
     ++accepted_;
-    spdlog::info("command {} #{} from '{}' accepted", command_name(cmd->command), cmd->seq, cmd->source);
+    spdlog::info("command {} #{} from '{}' accepted", command_name(cmd->command), cmd->seq, who);
   } else {
     ++refused_;
-    spdlog::warn("command {} #{} from '{}' refused: {}", command_name(cmd->command), cmd->seq, cmd->source, v.reason);
+    spdlog::warn("command {} #{} from '{}' refused: {}", command_name(cmd->command), cmd->seq, who, v.reason);
   }
   return v;
 }

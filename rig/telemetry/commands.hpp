@@ -14,6 +14,7 @@
 
 #include "rig/runtime/spsc_ring.hpp"
 #include "rig/runtime/triple_buffer.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 #include "vitreo_lcm/operator_command_t.hpp"
 
 namespace vitreo::telemetry {
@@ -88,9 +89,15 @@ struct LocalAck {
 
 class CommandServer {
  public:
-  // Subscribes to VITREO_COMMAND on `lcm`; acks are published on the same object.
-  explicit CommandServer(lcm::LCM& lcm, std::size_t queue_capacity = 64);
-  ~CommandServer();
+  // Limits on what a sender may put in a command (refused with a reason beyond them).
+  static constexpr std::size_t kMaxSourceLength = 31;   // printable ASCII, no spaces
+  static constexpr std::size_t kMaxArgLength = 64;      // the longest snapshot name
+  static constexpr std::size_t kMaxSources = 256;       // senders remembered for their sequence numbers
+
+  // Subscribes to VITREO_COMMAND on `lcm` (checked: a malformed packet is counted in `counters`,
+  // or in the server's own when null, and never reaches it); acks are published on the same object.
+  explicit CommandServer(lcm::LCM& lcm, std::size_t queue_capacity = 64, ChannelCounters* counters = nullptr);
+  ~CommandServer() = default;
   CommandServer(const CommandServer&) = delete;
   CommandServer& operator=(const CommandServer&) = delete;
 
@@ -110,6 +117,8 @@ class CommandServer {
 
   std::uint64_t accepted() const noexcept { return accepted_; }
   std::uint64_t refused() const noexcept { return refused_; }
+  // Packets on VITREO_COMMAND: received, refused undecoded, handler failures.
+  const ChannelCounters& receive_counters() const noexcept { return sub_.counters(); }
 
  private:
   void on_command(const vitreo_lcm::operator_command_t& cmd) { (void)handle(cmd); }
@@ -120,15 +129,20 @@ class CommandServer {
   } dispatch_{this};
 
   lcm::LCM& lcm_;
-  lcm::Subscription* sub_ = nullptr;
   runtime::TripleBuffer<CommandContext> context_;
   runtime::SpscRing<AcceptedCommand> queue_;
   runtime::SpscRing<LocalCommand> local_in_{32};
   runtime::SpscRing<LocalAck> local_acks_{32};
-  std::map<std::string, std::int64_t> last_seq_;  // per source: replays and reordering are refused
+  struct SourceState {
+    std::int64_t seq = 0;     // last sequence number seen: replays and reordering are refused
+    std::uint64_t heard = 0;  // when (in commands handled) it was last heard from
+  };
+  std::map<std::string, SourceState> last_seq_;  // at most kMaxSources, least recently heard forgotten
+  std::uint64_t heard_ = 0;
   std::string snapshot_folder_;
   std::uint64_t accepted_ = 0;
   std::uint64_t refused_ = 0;
+  CheckedSubscription sub_;  // last: unsubscribed first, before what its handler uses goes away
 };
 
 }  // namespace vitreo::telemetry

@@ -14,6 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/lcm_decode.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/recording_header_t.hpp"
@@ -187,7 +188,8 @@ Recording read_recording(const std::string& path) {
   while ((ev = log.readNextEvent()) != nullptr) {
     if (!have_header) {
       vitreo_lcm::recording_header_t h;
-      if (ev->channel != kChanRecHeader || h.decode(ev->data, 0, ev->datalen) < 0)
+      if (ev->channel != kChanRecHeader || ev->datalen < 0 ||
+          decode_message(ev->data, static_cast<std::size_t>(ev->datalen), h) != DecodeError::None)
         throw std::runtime_error("recording: '" + path + "' does not start with a " + kChanRecHeader + " event");
       if (h.format_version < 1 || h.format_version > vitreo_lcm::recording_header_t::FORMAT_VERSION)
         throw std::runtime_error("recording: '" + path + "' has format version " + std::to_string(h.format_version) +
@@ -199,7 +201,8 @@ Recording read_recording(const std::string& path) {
     } else if (ev->channel == kChanRecInput) {
       vitreo_lcm::device_input_t m;
       DeviceInput in;
-      if (m.decode(ev->data, 0, ev->datalen) < 0 || !from_lcm(m, in))
+      if (ev->datalen < 0 || decode_message(ev->data, static_cast<std::size_t>(ev->datalen), m) != DecodeError::None ||
+          !from_lcm(m, in))
         throw std::runtime_error("recording: undecodable input event " + std::to_string(ev->eventnum) + " in '" + path + "'");
       rec.inputs.push_back(in);
     } else {

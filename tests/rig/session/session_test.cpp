@@ -27,6 +27,7 @@
 #include "rig/session/rig_session.hpp"
 #include "rig/session/snapshot_writer.hpp"
 #include "rig/telemetry/channels.hpp"
+#include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 #include "vitreo_lcm/score_t.hpp"
@@ -232,6 +233,51 @@ TEST(RigSession, ReplayRebuildsTheCaseFromTheRecordingNotFromTheFolder) {
   EXPECT_EQ(replay.case_id, "exercise_pull_tissue");
   EXPECT_EQ(replay.state_hash, live.state_hash) << "replay rebuilt the case from the recording's text";
   std::filesystem::remove_all(dir);
+  std::filesystem::remove(config.record_path);
+}
+
+// A copy of a recording with its session-end marker's step count replaced (the events are read and
+// written with LCM's own log reader and writer, the marker decoded and re-encoded by lcm-gen's code).
+void rewrite_end_marker(const std::string& from, const std::string& to, double steps) {
+  lcm::LogFile in(from, "r");
+  lcm::LogFile out(to, "w");
+  ASSERT_TRUE(in.good() && out.good());
+  std::vector<std::uint8_t> buf;
+  bool found = false;
+  for (const lcm::LogEvent* ev = in.readNextEvent(); ev != nullptr; ev = in.readNextEvent()) {
+    lcm::LogEvent copy = *ev;
+    vitreo_lcm::device_input_t m;
+    if (ev->channel == telemetry::kChanRecInput && m.decode(ev->data, 0, ev->datalen) == ev->datalen &&
+        m.device_kind == rig::kSessionEndKind) {
+      m.values[0] = steps;
+      buf.resize(static_cast<std::size_t>(m.getEncodedSize()));
+      ASSERT_GT(m.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
+      copy.data = buf.data();
+      copy.datalen = static_cast<std::int32_t>(buf.size());
+      found = true;
+    }
+    ASSERT_EQ(out.writeEvent(&copy), 0);
+  }
+  ASSERT_TRUE(found) << "no session-end marker in " << from;
+}
+
+// Issue 20: an end marker saying NaN or 1e12 steps made the replay run for ever.
+TEST(RigSession, AnEndMarkerThatLiesAboutTheSessionLengthIsRefusedNotRunForEver) {
+  const auto config = small_session("end-marker", 300);
+  (void)rig::run_session(config);
+  for (double steps : {std::nan(""), 1e12, -1.0, 299.0, 301.0}) {
+    const std::string damaged = temp_path("end-marker-damaged.lcmlog");
+    rewrite_end_marker(config.record_path, damaged, steps);
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      (void)rig::replay_session(damaged, config.model);
+      ADD_FAILURE() << "an end marker of " << steps << " steps was replayed";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("session-end marker"), std::string::npos) << e.what();
+    }
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30));
+    std::filesystem::remove(damaged);
+  }
   std::filesystem::remove(config.record_path);
 }
 

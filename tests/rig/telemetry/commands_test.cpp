@@ -81,7 +81,7 @@ TEST(CommandServer, AcksEveryCommandAndQueuesOnlyAcceptedOnesToPhysics) {
     std::vector<vitreo_lcm::command_ack_t> got;
     void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
   } acks;
-  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
+  auto sub1 = subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
 
   // Physics publishes its context: case 1 of 2, running.
   CommandContext ctx;
@@ -146,7 +146,7 @@ TEST(CommandServer, FullPhysicsQueueRefusesWithAReason) {
     std::vector<vitreo_lcm::command_ack_t> got;
     void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
   } acks;
-  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
+  auto sub2 = subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
   for (int i = 1; i <= 3; ++i) {
     const Cmd c = make(Cmd::TOGGLE_LABELS, i);
     lc.publish(kChanCommand, &c);

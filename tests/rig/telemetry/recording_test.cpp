@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +23,7 @@
 #include "rig/runtime/clock.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "tests/rig/telemetry/lcm_bytes.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/recording_header_t.hpp"
 
@@ -212,6 +214,33 @@ TEST(Recording, RejectsFilesThatAreNotRecordings) {
   }
   std::remove(plain.c_str());
   std::remove(future.c_str());
+}
+
+// Issue 20: a header whose first string length is INT_MIN made `vitreo --replay` segfault. Now it
+// is a recording that does not start with a header, said with the file's name.
+TEST(Recording, HeaderWithStringLengthIntMinIsRefusedWithTheFilesName) {
+  const std::string path = temp_path("rec-header-intmin");
+  {
+    vitreo::test::LcmBytes b;
+    b.i64(vitreo_lcm::recording_header_t::getHash()).i64(1).i32(1).str_len(INT_MIN).bytes(64, 'x');
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+    std::vector<std::uint8_t> data = b.data();
+    lcm::LogEvent ev{};
+    ev.eventnum = 0;
+    ev.timestamp = 1;
+    ev.channel = kChanRecHeader;
+    ev.datalen = static_cast<std::int32_t>(data.size());
+    ev.data = data.data();
+    ASSERT_EQ(log.writeEvent(&ev), 0);
+  }
+  try {
+    read_recording(path);
+    ADD_FAILURE() << "a header with a length of INT_MIN was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
 }
 
 // The real lcm-logplayer reads our log and republishes every event through LCM's file provider;
