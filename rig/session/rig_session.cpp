@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -225,8 +226,14 @@ SessionSummary run_session(const SessionConfig& config) {
   std::array<std::pair<std::uint64_t, int>, kMaxSwitchLog> switch_log{};
   std::size_t switches = 0;
 
+  runtime::FixedStepLoop* physics_loop = nullptr;  // set before start(): the step ends it after a stop request
+  int stopped_by = 0;                              // the signal that ended the session early (physics thread)
   runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
+    // A stop request (SIGINT/SIGTERM) makes this step the session's last: it is finished, the end
+    // marker recorded, and nothing is cut off in the middle.
+    const int stop = config.stop ? config.stop->load(std::memory_order_relaxed) : 0;
+    const bool last = k + 1 == config.steps || stop != 0;
     if (config.on_step) config.on_step(k, hub);
     auto consume = [&](const telemetry::DeviceInput& in) {
       telemetry::DeviceInput stamped = in;
@@ -267,12 +274,12 @@ SessionSummary run_session(const SessionConfig& config) {
     context.case_count = model.case_count();
     commands.context().publish();
     hub.take_new(consume);
-    if (k + 1 == config.steps) consume(session_end_marker(config.steps));
+    if (last) consume(session_end_marker(k + 1));
     const core::StepReport report = model.step();
     // The model's metrics observed the step; running scores go out at a low rate (score() scans
     // the world), the final one with the last step.
-    if (k + 1 == config.steps || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
-      physics_out.push(score_item(model, step, k + 1 == config.steps));
+    if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
+      physics_out.push(score_item(model, step, last));
     for (const auto& slot : model.instruments()) {
       if (slot.frozen) {
         ++summary.frozen_steps;
@@ -297,7 +304,7 @@ SessionSummary run_session(const SessionConfig& config) {
         if (slots[i].present) physics_out.push(to_state(slots[i], static_cast<int>(i), step, t_s));
       }
     }
-    if (renderer && (k % view_every == 0 || k + 1 == config.steps)) {
+    if (renderer && (k % view_every == 0 || last)) {
       if (capture_view(model, k, t_s, views.write_slot())) views.publish();
     }
     if (loop && (k + 1) % 250 == 0) {  // physics timing at 4 Hz, cumulative over the session
@@ -305,8 +312,13 @@ SessionSummary run_session(const SessionConfig& config) {
       t.paused = model.paused();
       physics_out.push(t);
     }
+    if (last && stop != 0) {
+      stopped_by = stop;
+      physics_loop->request_stop();
+    }
   });
   loop = &harness.loop();
+  physics_loop = &harness.loop();
   std::int64_t next_receive_status_ns = 0;
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();
@@ -342,7 +354,6 @@ SessionSummary run_session(const SessionConfig& config) {
   if (terminal) terminal->stop();
   harness.stop();
   hub.stop();
-  if (recorder) recorder->close();
   publisher.pump();
   publisher.publish_receive_status("vitreo");  // the session's last word on what it received
   if (renderer) {
@@ -366,6 +377,9 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.snapshots = snapshots.written();
 
   summary.steps = harness.loop().stats().steps;
+  if (stopped_by != 0) {
+    summary.stop_reason = stopped_by == SIGINT ? "SIGINT" : stopped_by == SIGTERM ? "SIGTERM" : "signal " + std::to_string(stopped_by);
+  }
   summary.simulated_s = static_cast<double>(summary.steps) * config.model.dt_s;
   summary.loop = harness.loop().stats();
   summary.inputs_applied = model.inputs_applied();
@@ -385,6 +399,13 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.telemetry_published = publisher.published();
   summary.telemetry_dropped = publisher.dropped();
   summary.state_hash = model.state_hash();
+  if (recorder) {
+    // The end event: the recording is complete, and says which state a replay must reach.
+    if (!recorder->finish(telemetry::RecordingEnd{static_cast<std::int64_t>(summary.steps), summary.state_hash, summary.stop_reason}))
+      summary.recording_problem = "the recording failed during the session (see the log): it is incomplete";
+    summary.inputs_recorded = recorder->written();
+    summary.recorder_dropped = recorder->dropped();
+  }
   summary.score_lines = score_lines(model);
   for (std::size_t i = 0; i < hub.device_count(); ++i) {
     const auto& st = hub.stats(i);
@@ -399,40 +420,36 @@ SessionSummary run_session(const SessionConfig& config) {
 }
 
 ReplaySummary replay_session(const std::string& path, const ModelConfig& base, bool real_time) {
-  const telemetry::Recording rec = telemetry::read_recording(path);
+  const telemetry::Recording rec = telemetry::read_recording(path, &check_recorded_input);
   // The cases as they were recorded: their texts are in the header, not read from scenes/.
   ModelConfig model_config = base;
   if (rec.header.config_name != "vitreo-cases") {
-    throw std::runtime_error(path + ": recording has no case list (config '" + rec.header.config_name +
-                             "'); it was made by an older vitreo");
+    throw telemetry::RecordingError(path + ": recording has no case list (config '" + rec.header.config_name.substr(0, 64) +
+                                    "'); it was made by an older vitreo");
   }
   decode_case_list(rec.header.config_text, model_config);
   model_config.load.textures = false;  // physics only
   SimulationModel model(model_config);
   const std::string start = hex(model.current_case().start_hash);
-  if (!rec.header.snapshot_hash.empty() && rec.header.snapshot_hash != start) {
-    throw std::runtime_error(path + ": the recorded case '" + rec.header.case_id + "' rebuilds to start state " + start +
-                             ", the recording started from " + rec.header.snapshot_hash +
-                             " (a different build of the simulation?)");
+  if (rec.header.snapshot_hash != start) {
+    throw telemetry::RecordingError(path + ": the recorded case '" + rec.header.case_id.substr(0, 64) +
+                                    "' rebuilds to start state " + start + ", the recording started from " +
+                                    rec.header.snapshot_hash + " (a different build of the simulation?)");
+  }
+  for (const auto& in : rec.inputs) {
+    if (in.device_kind == kCaseKind && static_cast<int>(in.values[0]) >= model.case_count()) {
+      throw telemetry::RecordingError(path + ": an input at step " + std::to_string(in.step) + " switches to case " +
+                                      std::to_string(static_cast<int>(in.values[0])) + " of a list of " +
+                                      std::to_string(model.case_count()));
+    }
   }
   telemetry::InputCursor cursor(rec);
   std::uint64_t steps = 0;
   std::uint64_t inputs = 0;
-  // The session's last step is the last one that consumed an input, or later: replay as many steps
-  // as the header's duration says when present, else through the last input.
-  std::uint64_t total = rec.inputs.empty() ? 0 : static_cast<std::uint64_t>(rec.inputs.back().step) + 1;
-  for (const auto& in : rec.inputs) {
-    if (in.device_kind != kSessionEndKind) continue;
-    // Recorded at the session's last step with the number of steps run: anything else (NaN, 1e12, a
-    // count that disagrees with its own step) is a damaged recording, not a length to run for.
-    const double n = in.n_values >= 1 ? in.values[0] : std::nan("");
-    if (!(n == static_cast<double>(in.step + 1)) || in.step < 0) {
-      throw std::runtime_error(path + ": the session-end marker at step " + std::to_string(in.step) +
-                               " says the session ran " + fmt::format("{}", n) + " steps (expected " +
-                               std::to_string(in.step + 1) + "): the recording is damaged");
-    }
-    total = static_cast<std::uint64_t>(in.step) + 1;
-  }
+  // A complete recording says how many steps the session ran; one that is not is replayed through
+  // the last step it can vouch for (read_recording decided which).
+  const std::int64_t through = rec.end ? rec.end->steps - 1 : rec.trusted_through_step;
+  const std::uint64_t total = through < 0 ? 0 : static_cast<std::uint64_t>(through) + 1;
   runtime::SimulatedClock sim;
   runtime::SteadyClock wall;
   runtime::Clock& clock = real_time ? static_cast<runtime::Clock&>(wall) : static_cast<runtime::Clock&>(sim);
@@ -456,6 +473,12 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.case_id = rec.header.case_id;
   for (const auto& c : model_config.cases) out.cases.push_back(c.file_name);
+  out.verdict = rec.verdict;
+  out.verdict_text = rec.describe();
+  if (rec.end) {
+    out.recorded_state_hash = rec.end->state_hash;
+    out.stop_reason = rec.end->stop_reason;
+  }
   return out;
 }
 

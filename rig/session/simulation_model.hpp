@@ -34,6 +34,11 @@ inline constexpr std::int8_t kCommandKind = 6;
 // take effect when the loader thread has the case ready, so the step they land on is recorded.
 inline constexpr std::int8_t kCaseKind = 7;
 
+// A recorded input's meaning, range-checked (telemetry::read_recording's InputCheck): a known kind,
+// finite values, a session-end marker that counts its own step, a case index and a command code that
+// exist. nullptr when fine, else why not.
+const char* check_recorded_input(const telemetry::DeviceInput& in) noexcept;
+
 struct ModelConfig {
   // The session's cases (scenes/*.toml as text, so a recording can carry them); first_case starts.
   std::vector<scene_io::CaseText> cases;

@@ -80,8 +80,10 @@ TEST(RigSession, ARecordedSessionReplaysToTheSameState) {
   EXPECT_EQ(live.inputs_recorded, live.inputs_applied + live.inputs_refused);
 
   const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.verdict, telemetry::RecordingVerdict::Complete) << replay.verdict_text;
   EXPECT_EQ(replay.steps, live.steps);
   EXPECT_EQ(replay.state_hash, live.state_hash) << "replay diverged from the live session";
+  EXPECT_TRUE(replay.matches_recording()) << "the recording's end event carries the live final state";
   const double speed = static_cast<double>(replay.steps) * 1e-3 / replay.wall_s;
   std::printf("replay of %llu steps: %.1fx real time\n", static_cast<unsigned long long>(replay.steps), speed);
   std::filesystem::remove(config.record_path);
@@ -261,20 +263,18 @@ void rewrite_end_marker(const std::string& from, const std::string& to, double s
   ASSERT_TRUE(found) << "no session-end marker in " << from;
 }
 
-// Issue 20: an end marker saying NaN or 1e12 steps made the replay run for ever.
-TEST(RigSession, AnEndMarkerThatLiesAboutTheSessionLengthIsRefusedNotRunForEver) {
+// Issue 20: an end marker saying NaN or 1e12 steps made the replay run for ever. Now it is a
+// corruption (a range check and the checksum both catch it): replayed up to the block before it.
+TEST(RigSession, AnEndMarkerThatLiesAboutTheSessionLengthIsACorruptionNotALength) {
   const auto config = small_session("end-marker", 300);
   (void)rig::run_session(config);
   for (double steps : {std::nan(""), 1e12, -1.0, 299.0, 301.0}) {
     const std::string damaged = temp_path("end-marker-damaged.lcmlog");
     rewrite_end_marker(config.record_path, damaged, steps);
     const auto t0 = std::chrono::steady_clock::now();
-    try {
-      (void)rig::replay_session(damaged, config.model);
-      ADD_FAILURE() << "an end marker of " << steps << " steps was replayed";
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find("session-end marker"), std::string::npos) << e.what();
-    }
+    const rig::ReplaySummary r = rig::replay_session(damaged, config.model);
+    EXPECT_EQ(r.verdict, telemetry::RecordingVerdict::Corrupted) << steps << ": " << r.verdict_text;
+    EXPECT_LT(r.steps, 300u);
     EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30));
     std::filesystem::remove(damaged);
   }
@@ -303,6 +303,35 @@ TEST(CaseList, RoundTripsTheTextsAndRefusesATruncatedOne) {
   EXPECT_THROW(rig::decode_case_list(text.substr(0, text.size() - 10), untouched), std::runtime_error);
   EXPECT_THROW(rig::decode_case_list("retina-cap vertices=5000", untouched), std::runtime_error);
   EXPECT_TRUE(untouched.cases.empty()) << "a refused list leaves the configuration alone";
+}
+
+// Issue 20: lengths that overflow gave an unreadable substr message, and numbers too big for an int
+// were silently cut down. Each is now refused with the line that is wrong.
+TEST(CaseList, RefusesHugeLengthsAndNumbersOutOfRangeByName) {
+  const std::string one = "case 1 1 0\nab";
+  auto refused = [](const std::string& text, const char* says) {
+    rig::ModelConfig m;
+    try {
+      rig::decode_case_list(text, m);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  refused("vitreo-cases 1\ncase 99999999999999999999 0 0\n", "bad case line");
+  refused("vitreo-cases 1\ncase 9223372036854775807 9223372036854775807 2\nxy", "bad case line");
+  refused("vitreo-cases 1\ncase -1 2 0\nab", "bad case line");
+  refused("vitreo-cases 1\nretina_vertices 3000000000\n" + one, "retina_vertices out of range");
+  refused("vitreo-cases 1\nretina_vertices 12abc\n" + one, "retina_vertices out of range");
+  refused("vitreo-cases 1\ntexture_size_px -4\n" + one, "texture_size_px out of range");
+  refused("vitreo-cases 1\nfirst_case 1\n" + one, "first case out of range");
+  refused("vitreo-cases 1\nfirst_case 1 2\n" + one, "bad line");
+  rig::ModelConfig ok;
+  rig::decode_case_list("vitreo-cases 1\nretina_vertices 2000000\n" + one, ok);
+  EXPECT_EQ(ok.load.retina_vertices, 2'000'000);
+  ASSERT_EQ(ok.cases.size(), 1u);
+  EXPECT_EQ(ok.cases[0].file_name, "a");
+  EXPECT_EQ(ok.cases[0].text, "b");
 }
 
 TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts) {

@@ -88,6 +88,13 @@ TEST(LcmDecode, EveryOtherLieAboutAStringLengthIsRefused) {
   }
 }
 
+TEST(LcmDecode, AStringWithoutItsTerminatingNulIsRefused) {
+  // Length 4 counts "abc" and its NUL; here the fourth byte is 'd'.
+  LcmBytes b;
+  b.i64(Cmd::getHash()).i64(1).str_len(4).raw("abcd").i64(1).i8(Cmd::PAUSE).f64(0).str("");
+  EXPECT_EQ(decode<Cmd>(b), DecodeError::Malformed);
+}
+
 TEST(LcmDecode, NegativeOrImpossibleArrayCountsAreRefused) {
   for (std::int16_t n : {std::int16_t{-1}, std::int16_t{-32768}, std::int16_t{32767}, std::int16_t{3}}) {
     LcmBytes b;
