@@ -251,28 +251,28 @@ SessionSummary run_session(const SessionConfig& config) {
       if (!retiring) retiring = model.take_retired();
     }
     if (retiring && !switcher.retire(retiring)) { /* ring full: try again next step */ }
+    // Operator commands, decided here in order against the state the previous one left (its ack
+    // says so): a pending case switch counts as the current case, so "next, next" walks two cases.
     telemetry::AcceptedCommand cmd;
     while (commands.poll(cmd)) {
-      consume(command_input(cmd));
       const int target = switcher.pending() >= 0 ? switcher.pending() : model.case_index();
-      switch (cmd.code) {
-        case telemetry::CommandCode::NextCase: switcher.request(std::min(target + 1, model.case_count() - 1)); break;
-        case telemetry::CommandCode::PreviousCase: switcher.request(std::max(target - 1, 0)); break;
-        // Reset: the case the operator is in — or on the way to, when a switch is still loading.
-        case telemetry::CommandCode::Reset: switcher.request(target); break;
-        case telemetry::CommandCode::SaveSnapshot:
-          (void)snapshots.capture(model.world(), model.scene().description.name, cmd.arg, k);
-          break;
-        default: break;
+      const telemetry::CommandContext ctx{target, model.case_count(), model.paused()};
+      telemetry::CommandRefusal why = telemetry::decide_command(cmd.code, ctx);
+      if (why == telemetry::CommandRefusal::None && cmd.code == telemetry::CommandCode::SaveSnapshot &&
+          !snapshots.capture(model.world(), model.scene().description.name, cmd.arg, k))
+        why = telemetry::CommandRefusal::SnapshotBusy;
+      if (why == telemetry::CommandRefusal::None) {
+        consume(command_input(cmd));
+        switch (cmd.code) {
+          case telemetry::CommandCode::NextCase: switcher.request(target + 1); break;
+          case telemetry::CommandCode::PreviousCase: switcher.request(target - 1); break;
+          // Reset: the case the operator is in — or on the way to, when a switch is still loading.
+          case telemetry::CommandCode::Reset: switcher.request(target); break;
+          default: break;
+        }
       }
+      commands.report(cmd, why, ctx);
     }
-    // What the command server validates the next commands against: the case a pending switch
-    // leads to counts as current, so "next, next" walks two cases.
-    telemetry::CommandContext& context = commands.context().write_slot();
-    context.paused = model.paused();
-    context.case_index = switcher.pending() >= 0 ? switcher.pending() : model.case_index();
-    context.case_count = model.case_count();
-    commands.context().publish();
     hub.take_new(consume);
     if (last) consume(session_end_marker(k + 1));
     const core::StepReport report = model.step();
@@ -323,7 +323,7 @@ SessionSummary run_session(const SessionConfig& config) {
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();
     publisher.handle_incoming();
-    commands.pump_local();  // commands typed on the terminal: the same validation and queue
+    commands.pump_local();  // terminal commands in, physics' decisions back, acks out
     if (const std::int64_t now = wall.now_ns(); now >= next_receive_status_ns) {  // 1 Hz (CHANNELS.md)
       publisher.publish_receive_status("vitreo");
       next_receive_status_ns = now + 1'000'000'000;
@@ -354,6 +354,7 @@ SessionSummary run_session(const SessionConfig& config) {
   if (terminal) terminal->stop();
   harness.stop();
   hub.stop();
+  commands.abandon_pending("the session ended before physics carried it out");
   publisher.pump();
   publisher.publish_receive_status("vitreo");  // the session's last word on what it received
   if (renderer) {

@@ -29,6 +29,7 @@
 #include "rig/telemetry/channels.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
+#include "vitreo_lcm/physics_timing_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 #include "vitreo_lcm/score_t.hpp"
 
@@ -413,6 +414,54 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
 // save snapshot, a refused zoom, previous case and reset act on the live session at step
 // boundaries; the case switches are recorded, so the replay — which loads the cases from the
 // recording in place — ends in the same state.
+// Issue 20: commands piped in together are decided in order by physics (pause then resume: both
+// accepted, the session runs on), a 70-character snapshot name is refused whole (it was cut to 64
+// and accepted), and a last line without its newline is still executed.
+TEST(RigSession, PipedCommandsAreDecidedInOrderAndTheLastLineCountsWithoutItsNewline) {
+  auto config = small_session("piped", 1500);
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string name70(70, 'a');
+  const std::string script = "pause\nresume\ns " + name70 + "\nw";
+  ASSERT_EQ(::write(fds[1], script.data(), script.size()), static_cast<ssize_t>(script.size()));
+  ::close(fds[1]);  // end of input right after "w"
+  config.command_fd = fds[0];
+  std::FILE* echo = std::tmpfile();
+  ASSERT_NE(echo, nullptr);
+  config.command_echo = echo;
+  const rig::SessionSummary live = rig::run_session(config);
+  ::close(fds[0]);
+  std::rewind(echo);
+  std::string acks;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, echo)) acks += buf;
+  std::fclose(echo);
+  const auto pause = acks.find("> pause: accepted"), resume = acks.find("> resume: accepted");
+  EXPECT_NE(pause, std::string::npos) << acks;
+  EXPECT_NE(resume, std::string::npos) << acks;
+  EXPECT_LT(pause, resume) << acks;
+  EXPECT_NE(acks.find("> snapshot name must be 1-64 characters"), std::string::npos) << acks;
+  EXPECT_NE(acks.find("> toggle_wireframe: accepted"), std::string::npos) << "the last line, without a newline:\n" << acks;
+  EXPECT_TRUE(live.snapshots.empty());
+  // The session ran on: its last timing report says it was not paused.
+  lcm::LogFile log(temp_path("piped-telemetry.lcmlog"), "r");
+  ASSERT_TRUE(log.good());
+  int timings = 0;
+  bool last_paused = true;
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev != nullptr; ev = log.readNextEvent()) {
+    vitreo_lcm::physics_timing_t t;
+    if (ev->channel == telemetry::kChanPhysicsTiming && t.decode(ev->data, 0, ev->datalen) == ev->datalen) {
+      last_paused = t.paused;
+      ++timings;
+    }
+  }
+  EXPECT_GT(timings, 0);
+  EXPECT_FALSE(last_paused) << "the session stayed paused against the operator's last word";
+  const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.state_hash, live.state_hash);
+  std::filesystem::remove(config.record_path);
+}
+
 TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReproducesThem) {
   auto config = small_session("commands", 6000);
   config.model = small_model({kScenes + "/exercise_pull_tissue.toml", kScenes + "/exercise_cut_path.toml"});

@@ -18,6 +18,7 @@
 #include "rig/telemetry/lcm_decode.hpp"
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "tests/rig/telemetry/lcm_bytes.hpp"
+#include "tests/rig/telemetry/physics_stand_in.hpp"
 #include "vitreo_lcm/command_ack_t.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/operator_command_t.hpp"
@@ -173,16 +174,18 @@ TEST(CommandServer, MalformedCommandsAreCountedNeverAnsweredAndValidOnesStillAck
     void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
   } acks;
   CheckedSubscription ack_sub = subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
-  CommandContext ctx;
-  ctx.case_count = 2;
-  server.context().write(ctx);
+  vitreo::test::PhysicsStandIn physics;
+  physics.ctx.case_count = 2;
 
   publish_raw(lc, kChanCommand, command_bytes("x", 1, Cmd::PAUSE, "", true, INT_MIN));
   publish_raw(lc, kChanCommand, command_bytes("", 1, Cmd::PAUSE, "", true, 0));
   publish_raw(lc, kChanCommand, command_bytes("ok", 1, Cmd::PAUSE));
   drain(lc);
+  physics.step(server);
   publish_raw(lc, kChanCommand, command_bytes("ok", 2, Cmd::NEXT_CASE, "", true, -7));
   publish_raw(lc, kChanCommand, command_bytes("ok", 3, Cmd::NEXT_CASE));
+  drain(lc);
+  physics.step(server);
   drain(lc);
   ASSERT_EQ(acks.got.size(), 2u);
   EXPECT_TRUE(acks.got[0].accepted) << acks.got[0].reason;
@@ -202,6 +205,7 @@ TEST(CommandServer, RefusesSourcesAndArgumentsBeyondItsLimitsAndStaysBounded) {
     void operator()(const vitreo_lcm::command_ack_t& a) { got.push_back(a); }
   } acks;
   CheckedSubscription ack_sub = subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &acks);
+  vitreo::test::PhysicsStandIn physics;
   publish_raw(lc, kChanCommand, command_bytes(std::string(40, 'a'), 1, Cmd::TOGGLE_LABELS));
   publish_raw(lc, kChanCommand, command_bytes("with space", 1, Cmd::TOGGLE_LABELS));
   publish_raw(lc, kChanCommand, command_bytes("bell\a", 1, Cmd::TOGGLE_LABELS));
@@ -221,8 +225,11 @@ TEST(CommandServer, RefusesSourcesAndArgumentsBeyondItsLimitsAndStaysBounded) {
     publish_raw(lc, kChanCommand, command_bytes("s" + std::to_string(i), 1, Cmd::TOGGLE_LABELS));
     if (i % 50 == 0) publish_raw(lc, kChanCommand, command_bytes("real", 11 + i, Cmd::TOGGLE_LABELS));
     drain(lc);
+    physics.step(server);
   }
   publish_raw(lc, kChanCommand, command_bytes("real", 5, Cmd::TOGGLE_LABELS));  // a replay
+  drain(lc);
+  physics.step(server);
   drain(lc);
   spdlog::set_level(level);
   EXPECT_FALSE(acks.got.back().accepted);

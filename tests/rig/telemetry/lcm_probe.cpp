@@ -38,6 +38,7 @@
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "tests/rig/telemetry/malformed_packets.hpp"
+#include "tests/rig/telemetry/physics_stand_in.hpp"
 #include "vitreo_lcm/event_t.hpp"
 #include "vitreo_lcm/receive_status_t.hpp"
 
@@ -190,16 +191,16 @@ int main(int argc, char** argv) {
             pub.lcm().getUnderlyingLCM());
       }
       CommandServer server(pub.lcm());
-      CommandContext ctx;
-      ctx.case_index = 0;
-      ctx.case_count = 3;
-      server.context().write(ctx);
+      vitreo::test::PhysicsStandIn physics;  // case 1 of 3, running
+      physics.ctx.case_count = 3;
       std::printf("lcm_probe: responding\n");
       std::fflush(stdout);
       const std::uint64_t n = static_cast<std::uint64_t>(std::atol(argv[3]));
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(std::atol(argv[4]));
-      while (server.accepted() + server.refused() < n && std::chrono::steady_clock::now() < deadline)
-        pub.lcm().handleTimeout(50);
+      while (server.accepted() + server.refused() < n && std::chrono::steady_clock::now() < deadline) {
+        pub.lcm().handleTimeout(5);
+        physics.step(server);
+      }
       std::printf("lcm_probe: %llu accepted, %llu refused\n", static_cast<unsigned long long>(server.accepted()),
                   static_cast<unsigned long long>(server.refused()));
       if (noise) lcm_unsubscribe(pub.lcm().getUnderlyingLCM(), noise);
