@@ -24,17 +24,18 @@ const char* to_string(LinkState s) {
 }
 
 std::string to_string(const LinkStats& s) {
-  char b[512];
+  char b[640];
   std::snprintf(b, sizeof b,
                 "bytes=%llu frames=%llu valid=%llu crc=%llu framing=%llu version=%llu unknown=%llu length=%llu "
-                "range=%llu drops=%llu ts_jumps=%llu stuck=%llu delivered=%llu disconnects=%llu reconnects=%llu "
+                "range=%llu drops=%llu ts_jumps=%llu stuck=%llu stuck_episodes=%llu delivered=%llu disconnects=%llu reconnects=%llu "
                 "latency_us(last/mean/max)=%llu/%.0f/%llu",
                 (unsigned long long)s.bytes, (unsigned long long)s.frames, (unsigned long long)s.valid,
                 (unsigned long long)s.crc_errors, (unsigned long long)s.framing_errors,
                 (unsigned long long)s.version_errors, (unsigned long long)s.unknown_type,
                 (unsigned long long)s.length_errors, (unsigned long long)s.range_rejected,
                 (unsigned long long)s.drops, (unsigned long long)s.timestamp_jumps,
-                (unsigned long long)s.stuck_samples, (unsigned long long)s.samples_delivered,
+                (unsigned long long)s.stuck_samples, (unsigned long long)s.stuck_episodes,
+                (unsigned long long)s.samples_delivered,
                 (unsigned long long)s.disconnects, (unsigned long long)s.reconnects,
                 (unsigned long long)s.latency_last_us, s.latency_mean_us, (unsigned long long)s.latency_max_us);
   return b;
@@ -135,7 +136,8 @@ void DeviceSession::transport_up(std::uint64_t now_us) {
   last_seq_ = -1;
   have_device_us_ = false;
   last_host_us_ = 0;
-  same_count_ = 0;
+  last_payload_.clear();
+  stuck_ = false;
   clock_.reset();
   last_frame_us_ = now_us;
   set_state(LinkState::connecting, now_us, "transport open");
@@ -227,20 +229,12 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       for (int i = 0; i < 4; ++i) s.q_wxyz[i] = p.q_wxyz[i];
       s.actuation = p.actuation / 65535.0f;
       s.quality = p.quality_pct / 100.0f;
-      // a real tracker's floats always jitter; a long run of bit-identical poses is a frozen sensor
+      // a real tracker's floats always jitter; bit-identical poses for 50 ms are a frozen sensor
       std::uint8_t key[30];
       std::memcpy(key, p.tip_mm, 12);
       std::memcpy(key + 12, p.q_wxyz, 16);
       std::memcpy(key + 28, &p.actuation, 2);
-      if (last_payload_.size() == sizeof key && std::memcmp(last_payload_.data(), key, sizeof key) == 0) {
-        if (++same_count_ >= cfg_.stuck_after) {
-          s.stuck = true;
-          ++stats_.stuck_samples;
-        }
-      } else {
-        same_count_ = 0;
-        last_payload_.assign(key, key + sizeof key);
-      }
+      s.stuck = check_stuck(key, sizeof key, p.timestamp_us);
       deliver(s, p.timestamp_us, now_us);
       return;
     }
@@ -263,6 +257,10 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
         s.inserted[i] = p.ports[i].flags & 1u;
         s.depth_mm[i] = p.ports[i].depth_mm;
       }
+      std::uint8_t key[32];
+      std::memcpy(key, p.q_wxyz, 16);
+      for (int i = 0; i < 4; ++i) std::memcpy(key + 16 + 4 * i, &p.ports[i].depth_mm, 4);
+      s.stuck = check_stuck(key, sizeof key, p.timestamp_us);
       deliver(s, p.timestamp_us, now_us);
       return;
     }
@@ -270,6 +268,25 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       if (on_message_) on_message_(m);
       return;
   }
+}
+
+bool DeviceSession::check_stuck(const void* payload, std::size_t size, std::uint64_t device_us) {
+  // Samples before streaming are not delivered; a timestamp that goes back starts afresh.
+  const bool same = last_payload_.size() == size && std::memcmp(last_payload_.data(), payload, size) == 0 &&
+                    device_us >= same_since_device_us_;
+  if (!same) {
+    const auto* b = static_cast<const std::uint8_t*>(payload);
+    last_payload_.assign(b, b + size);
+    same_since_device_us_ = device_us;
+    stuck_ = false;
+    return false;
+  }
+  if (device_us - same_since_device_us_ >= cfg_.stuck_after_us) {
+    if (!stuck_) ++stats_.stuck_episodes;
+    stuck_ = true;
+    ++stats_.stuck_samples;
+  }
+  return stuck_;
 }
 
 bool DeviceSession::request_calibration(std::uint8_t procedure, std::uint8_t instrument_id, std::uint16_t token) {

@@ -349,6 +349,7 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(s.inputs_applied), static_cast<unsigned long long>(s.inputs_refused),
                 static_cast<unsigned long long>(s.inputs_recorded), static_cast<unsigned long long>(s.recorder_dropped));
     for (const auto& line : s.device_lines) std::printf("  device           %s\n", line.c_str());
+    for (const auto& line : s.fault_lines) std::printf("  sensor faults    %s\n", line.c_str());
     std::printf("  events           %llu grasps, %llu burns, %llu attachments broken, %llu tears, %llu instrument events, "
                 "%llu steps rolled back\n",
                 static_cast<unsigned long long>(s.grasps), static_cast<unsigned long long>(s.burns),

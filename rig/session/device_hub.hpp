@@ -64,6 +64,10 @@ class DeviceHub {
   const drivers::LinkStats& stats(std::size_t device) const { return devices_[device]->driver->session().stats(); }
   const std::string& name(std::size_t device) const { return devices_[device]->spec.name; }
   std::uint64_t link_events_dropped() const { return links_.dropped(); }
+  // The driver thread's starvation: passes that came >= kReaderStallUs after the previous one.
+  static constexpr std::uint64_t kReaderStallUs = 20'000;
+  std::uint64_t reader_stalls() const { return reader_stalls_.load(std::memory_order_relaxed); }
+  std::uint64_t reader_stall_max_us() const { return reader_stall_max_us_.load(std::memory_order_relaxed); }
 
  private:
   struct Device {
@@ -75,6 +79,7 @@ class DeviceHub {
     std::int64_t last_taken = -1;
     std::atomic<int> plug_request{0};  // +1 plug, -1 unplug
     drivers::LinkState last_state = drivers::LinkState::lost;  // as last published (driver thread)
+    bool stuck_reported = false;                              // driver thread
   };
   void run_sims();
   void run_drivers();
@@ -85,6 +90,7 @@ class DeviceHub {
   telemetry::TelemetrySource* status_out_;
   drivers::SteadyClock clock_;
   std::atomic<bool> running_{false};
+  std::atomic<std::uint64_t> reader_stalls_{0}, reader_stall_max_us_{0};
   std::thread sim_thread_, driver_thread_;
 };
 

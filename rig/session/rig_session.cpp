@@ -410,12 +410,31 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.score_lines = score_lines(model);
   for (std::size_t i = 0; i < hub.device_count(); ++i) {
     const auto& st = hub.stats(i);
-    char line[256];
+    char line[512];
     std::snprintf(line, sizeof line, "%-10s frames %llu, valid %llu, CRC errors %llu, samples %llu, reconnects %llu",
                   hub.name(i).c_str(), static_cast<unsigned long long>(st.frames),
                   static_cast<unsigned long long>(st.valid), static_cast<unsigned long long>(st.crc_errors),
                   static_cast<unsigned long long>(st.samples_delivered), static_cast<unsigned long long>(st.reconnects));
     summary.device_lines.emplace_back(line);
+    // Sensor faults, each only when it happened: what a technician has to look at.
+    std::string faults;
+    auto add = [&](std::uint64_t n, const char* what) {
+      if (n == 0) return;
+      faults += (faults.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+    };
+    add(st.stuck_episodes, st.stuck_episodes == 1 ? "time stuck (instrument frozen)" : "times stuck (instrument frozen)");
+    add(st.stuck_samples, "samples while stuck");
+    add(st.range_rejected, "samples out of range");
+    add(st.timestamp_jumps, "timestamp jumps");
+    add(st.framing_errors, "framing errors");
+    add(st.drops, "frames missing (sequence gaps)");
+    add(st.version_errors + st.unknown_type + st.length_errors, "frames of another version, type or length");
+    if (!faults.empty()) summary.fault_lines.push_back(hub.name(i) + ": " + faults);
+  }
+  if (hub.reader_stalls() > 0) {
+    summary.fault_lines.push_back("driver thread starved " + std::to_string(hub.reader_stalls()) + " times (longest " +
+                                  std::to_string(hub.reader_stall_max_us() / 1000) +
+                                  " ms): framing errors and gaps may be this machine's load, not a device");
   }
   return summary;
 }

@@ -73,6 +73,9 @@ struct SessionSummary {
   std::vector<std::string> receive_lines;  // per subscribed LCM channel: received, refused, handler errors
   std::uint64_t state_hash = 0;
   std::vector<std::string> device_lines;  // per device: name, link statistics
+  // Sensor faults (stuck, out of range, timestamp jumps, framing errors, gaps) per device that had
+  // any, and the driver thread's starvation; empty when all was well.
+  std::vector<std::string> fault_lines;
   std::uint64_t instrument_events = 0;     // grasps, contacts, collisions, burns… (telemetry VITREO_EVENT)
   std::uint64_t frozen_steps = 0;          // steps during which an instrument was frozen (its tracker lost)
   std::uint64_t frames_rendered = 0, scenes_dropped = 0;

@@ -118,7 +118,8 @@ const char* check_recorded_input(const telemetry::DeviceInput& in) noexcept {
     case static_cast<std::int8_t>(InputKind::Eyeball):
       return nullptr;  // device samples: the model range-checks them as it does live
     case kLinkKind:
-      if (in.n_values < 1 || !integral(in.values[0], 1, 2)) return "a link change that is neither up nor lost";
+      if (in.n_values < 1 || !integral(in.values[0], 1, 3)) return "a link change that is not up, lost or stuck";
+      if (in.n_values >= 2 && !integral(in.values[1], 0, 3)) return "a link change of an unknown device type";
       return nullptr;
     case kSessionEndKind:
       if (in.n_values != 1 || in.values[0] != static_cast<double>(in.step + 1))
@@ -203,9 +204,13 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
     }
     ok = true;
   } else if (in.device_kind == kLinkKind && in.n_values >= 1) {
-    // Which instrument a tracker link carries is its channel.
-    if (in.channel >= 0 && in.channel < static_cast<int>(instruments_.size())) {
-      instruments_[static_cast<std::size_t>(in.channel)].frozen = static_cast<int>(in.values[0]) == static_cast<int>(LinkInput::Lost);
+    // Which instrument a tracker link carries is its channel; the pedals' and the fixture's links
+    // freeze no instrument (values[1]: the device's type, 1 a tracker; absent in older recordings).
+    const bool tracker = in.n_values < 2 || in.values[1] == 1.0;
+    if (tracker && in.channel >= 0 && in.channel < static_cast<int>(instruments_.size())) {
+      const int state = static_cast<int>(in.values[0]);
+      instruments_[static_cast<std::size_t>(in.channel)].frozen =
+          state == static_cast<int>(LinkInput::Lost) || state == static_cast<int>(LinkInput::Stuck);
     }
     ok = true;
   } else if (DecodedTracker t; decode_tracker(in, t)) {

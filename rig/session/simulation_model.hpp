@@ -23,8 +23,9 @@ namespace vitreo::rig {
 
 // A link's state as an input: a lost tracker must freeze its instrument in replay exactly when it
 // did live, so link changes are recorded like samples (device_kind kLinkKind, values[0] = state).
+// A stuck sensor (bit-identical poses for 50 ms) freezes its instrument the same way; Up ends both.
 inline constexpr std::int8_t kLinkKind = 4;
-enum class LinkInput : int { Up = 1, Lost = 2 };
+enum class LinkInput : int { Up = 1, Lost = 2, Stuck = 3 };
 // The session's end, recorded at its last step (values[0] = steps run) so a replay knows its length.
 inline constexpr std::int8_t kSessionEndKind = 5;
 // An accepted operator command (values[0] = telemetry::CommandCode, values[1] = its value): pause,

@@ -170,6 +170,13 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.latency_p50_us = v.latency_p50_us;
           m.latency_p99_us = v.latency_p99_us;
           m.clock_offset_us = v.clock_offset_us;
+          m.stuck = v.stuck;
+          m.stuck_episodes = v.stuck_episodes;
+          m.stuck_samples = v.stuck_samples;
+          m.range_rejected = v.range_rejected;
+          m.timestamp_jumps = v.timestamp_jumps;
+          m.reader_stalls = v.reader_stalls;
+          m.reader_stall_max_ms = v.reader_stall_max_ms;
           rc = publish(lcm_, kChanDeviceStatus, m);
         } else if constexpr (std::is_same_v<T, Score>) {
           vitreo_lcm::score_t m;

@@ -27,6 +27,7 @@
 #include "rig/session/rig_session.hpp"
 #include "rig/session/snapshot_writer.hpp"
 #include "rig/telemetry/channels.hpp"
+#include "rig/session/device_inputs.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/physics_timing_t.hpp"
@@ -193,6 +194,71 @@ TEST(RigSession, ALostTrackerFreezesItsInstrumentAndTheSessionCarriesOn) {
   EXPECT_GT(instrument_states, 300);
   EXPECT_GT(frozen_states, 0) << "telemetry shows the instrument frozen while its tracker was lost";
   EXPECT_TRUE(moving_after_frozen) << "the instrument resumed after the reconnect";
+  std::filesystem::remove(config.record_path);
+}
+
+// Issue 20: a frozen tracker was never reported and its poses were applied in silence. Now a
+// tracker whose poses stay bit-identical for 50 ms (the emulator's "stuck" fault: frozen values,
+// live timestamps) is reported within 100 ms — in the recording, on VITREO_DEVICE_STATUS and in the
+// summary — and its instrument is frozen as if the tracker were lost, until it moves again.
+TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilItMoves) {
+  auto config = small_session("stuck", 2500);
+  config.devices[0].sim_script = std::string(kTracker) + "fault 700 800 stuck\n";
+  const rig::SessionSummary live = rig::run_session(config);
+  EXPECT_GT(live.frozen_steps, 500u);
+  std::string faults;
+  for (const auto& l : live.fault_lines) faults += l + "\n";
+  EXPECT_NE(faults.find("tracker-0: 1 time stuck (instrument frozen)"), std::string::npos) << faults;
+
+  // From the recording: where the identical poses began, and when the stuck report came.
+  const telemetry::Recording rec = telemetry::read_recording(config.record_path);
+  ASSERT_EQ(rec.verdict, telemetry::RecordingVerdict::Complete) << rec.describe();
+  std::int64_t first_same_us = -1, stuck_us = -1, up_us = -1;
+  const telemetry::DeviceInput* prev = nullptr;
+  for (const auto& in : rec.inputs) {
+    if (in.device_kind == static_cast<std::int8_t>(rig::InputKind::Tracker)) {
+      const bool same = prev && std::memcmp(prev->values, in.values, sizeof(double) * 7) == 0;
+      if (same && first_same_us < 0 && stuck_us < 0) first_same_us = prev->host_time_us;
+      if (!same && stuck_us < 0) first_same_us = -1;  // a run that ended was noise, not the fault
+      prev = &in;
+    } else if (in.device_kind == rig::kLinkKind && in.channel == 0) {
+      if (in.values[0] == static_cast<double>(rig::LinkInput::Stuck) && stuck_us < 0) stuck_us = in.host_time_us;
+      if (in.values[0] == static_cast<double>(rig::LinkInput::Up) && stuck_us >= 0) up_us = in.host_time_us;
+    }
+  }
+  ASSERT_GE(first_same_us, 0) << "the fault's identical poses are in the recording";
+  ASSERT_GE(stuck_us, 0) << "the stuck report is in the recording";
+  std::printf("stuck reported %.1f ms after the first identical pose\n", static_cast<double>(stuck_us - first_same_us) * 1e-3);
+  EXPECT_GE(stuck_us - first_same_us, 50'000) << "not before 50 ms of identical poses";
+  EXPECT_LE(stuck_us - first_same_us, 100'000) << "reported within 100 ms";
+  EXPECT_GT(up_us, stuck_us) << "moving again ends it";
+
+  // Telemetry: the status said stuck, and the instrument was frozen, then moved again.
+  lcm::LogFile log(config.lcm_url.substr(7, config.lcm_url.find('?') - 7), "r");
+  ASSERT_TRUE(log.good());
+  bool saw_stuck = false, moving_after_frozen = false;
+  int frozen_states = 0;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    if (ev->channel == telemetry::kChanDeviceStatus) {
+      vitreo_lcm::device_status_t st;
+      ASSERT_EQ(st.decode(ev->data, 0, ev->datalen), ev->datalen);
+      if (st.name == "tracker-0" && st.stuck) {
+        saw_stuck = true;
+        EXPECT_GE(st.stuck_episodes, 1);
+        EXPECT_NE(st.detail.find("stuck"), std::string::npos) << st.detail;
+      }
+    } else if (ev->channel == telemetry::kChanInstrumentState) {
+      vitreo_lcm::instrument_state_t st;
+      ASSERT_EQ(st.decode(ev->data, 0, ev->datalen), ev->datalen);
+      if (st.instrument_id == 0 && st.frozen) ++frozen_states;
+      if (frozen_states > 0 && st.instrument_id == 0 && !st.frozen) moving_after_frozen = true;
+    }
+  }
+  EXPECT_TRUE(saw_stuck) << "VITREO_DEVICE_STATUS reported the stuck tracker";
+  EXPECT_GT(frozen_states, 100) << "the instrument was frozen while its tracker was stuck";
+  EXPECT_TRUE(moving_after_frozen);
+  const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.state_hash, live.state_hash) << "the freeze is recorded, so the replay freezes too";
   std::filesystem::remove(config.record_path);
 }
 
