@@ -3,6 +3,7 @@
 // is false, so `--duration nan` passed it and ran 2^63 steps; these refuse NaN and infinities.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include <fcntl.h>
@@ -27,15 +28,9 @@ inline std::string number_text(double v) {
 inline CLI::Validator finite_range(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& text) -> std::string {
-        std::size_t used = 0;
-        double v = 0;
-        try {
-          v = std::stod(text, &used);
-        } catch (...) {
-          return "'" + text + "' is not a number";
-        }
-        if (used != text.size()) return "'" + text + "' is not a number";
-        if (!std::isfinite(v) || v < lo || v > hi) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);  // HUGE_VAL for 1e999: refused as not finite
+        if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v) || v < lo || v > hi) {
           return "'" + text + "' is not a number in [" + number_text(lo) + ", " + number_text(hi) + "]";
         }
         return {};
@@ -47,10 +42,11 @@ inline CLI::Validator finite_range(double lo, double hi) {
 // `--serial tracker=/dev/null` used to run with a device that could never connect.
 inline std::string serial_port_problem(const std::string& path) {
   struct stat st{};
-  if (::stat(path.c_str(), &st) != 0) return "'" + path + "': " + (errno == ENOENT ? "no such device" : std::strerror(errno));
+  if (::stat(path.c_str(), &st) != 0)
+    return "cannot open '" + path + "': " + (errno == ENOENT ? "no such device" : std::strerror(errno));
   if (!S_ISCHR(st.st_mode)) return "'" + path + "' is not a serial port (not a character device)";
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return "'" + path + "': " + std::strerror(errno);
+  if (fd < 0) return "cannot open '" + path + "': " + std::strerror(errno);
   termios t{};
   const bool tty = ::tcgetattr(fd, &t) == 0;
   ::close(fd);

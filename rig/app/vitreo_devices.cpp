@@ -22,6 +22,8 @@
 #include "drivers/sim/can_sim.hpp"
 #include "drivers/sim/pty_sim.hpp"
 #include "drivers/usb.hpp"
+#include "rig/app/cli_checks.hpp"
+#include "rig/files/read_text_file.hpp"
 
 namespace {
 
@@ -68,6 +70,11 @@ struct AnyDevice {
 std::unique_ptr<AnyDevice> open_device(const LinkOptions& o, Clock& clock, std::string* why) {
   auto d = std::make_unique<AnyDevice>();
   if (!o.serial.empty()) {
+    // A path that is not a serial port (a file, /dev/null) would never connect: say so now.
+    if (std::string bad = vitreo::app::serial_port_problem(o.serial); !bad.empty()) {
+      *why = bad;
+      return nullptr;
+    }
     d->serial = std::make_unique<SerialDevice>(o.serial, clock, SessionConfig{}, o.baud);
   } else if (!o.usb.empty()) {
     const std::uint16_t pid = o.usb == "tracker" ? kTrackerPid : o.usb == "pedals" ? kPedalsPid : kEyeballPid;
@@ -199,6 +206,11 @@ int cmd_watch(const LinkOptions& o, double duration_s, double print_hz, bool raw
     return 1;
   }
   std::printf("[%s] %s\n", to_string(dev->session().state()), to_string(dev->session().stats()).c_str());
+  if (dev->session().stats().frames == 0) {
+    std::fprintf(stderr, "vitreo-devices: no frame from the device in %.1f s (%s)\n", duration_s,
+                 dev->session().last_error().empty() ? "is it connected and powered?" : dev->session().last_error().c_str());
+    return 1;
+  }
   return 0;
 }
 
@@ -206,15 +218,13 @@ int cmd_simulate(const std::string& kind, const std::string& script_path, const 
                  int node, bool fd, double duration_s) {
   sim::Script s;
   if (!script_path.empty()) {
-    std::ifstream in(script_path);
-    if (!in) {
-      std::fprintf(stderr, "vitreo-devices: cannot read script %s\n", script_path.c_str());
+    const auto file = vitreo::files::read_text_file(script_path);
+    if (!file.text) {
+      std::fprintf(stderr, "vitreo-devices: script: %s\n", file.error.c_str());
       return 2;
     }
-    std::stringstream ss;
-    ss << in.rdbuf();
     std::string err;
-    if (!sim::parse_script(ss.str(), s, &err)) {
+    if (!sim::parse_script(*file.text, s, &err)) {
       std::fprintf(stderr, "vitreo-devices: %s: %s\n", script_path.c_str(), err.c_str());
       return 2;
     }
@@ -273,16 +283,17 @@ int main(int argc, char** argv) {
   double id_timeout = 2, watch_s = 1e9, watch_hz = 10, dump_s = 1e9;
   auto* identify = app.add_subcommand("identify", "connect and print the device's identity");
   add_link_options(identify, id_opts);
-  identify->add_option("--timeout-s", id_timeout, "give up after this long")->check(CLI::PositiveNumber);
+  identify->add_option("--timeout-s", id_timeout, "give up after this long")->check(vitreo::app::finite_range(0.001, 86400));
 
   auto* watch = app.add_subcommand("watch", "live view of decoded samples and link statistics");
   add_link_options(watch, watch_opts);
-  watch->add_option("--duration-s", watch_s, "stop after this long")->check(CLI::PositiveNumber);
-  watch->add_option("--print-hz", watch_hz, "samples printed per second (the rest are counted)")->check(CLI::NonNegativeNumber);
+  watch->add_option("--duration-s", watch_s, "stop after this long")->check(vitreo::app::finite_range(0.001, 1e9));
+  watch->add_option("--print-hz", watch_hz, "samples printed per second (the rest are counted)")
+      ->check(vitreo::app::finite_range(0, 100000));
 
   auto* dump = app.add_subcommand("dump", "raw frame dump (hex), with link statistics each second");
   add_link_options(dump, dump_opts);
-  dump->add_option("--duration-s", dump_s, "stop after this long")->check(CLI::PositiveNumber);
+  dump->add_option("--duration-s", dump_s, "stop after this long")->check(vitreo::app::finite_range(0.001, 1e9));
 
   std::string kind = "tracker", script, link = "/tmp/vitreo-sim-tty", sim_can;
   int sim_node = -1;
@@ -290,13 +301,12 @@ int main(int argc, char** argv) {
   double sim_s = 1e9;
   auto* simulate = app.add_subcommand("simulate", "run a simulated device (firmware emulator) over a pty or CAN");
   simulate->add_option("--device", kind, "device kind")->check(CLI::IsMember({"tracker", "pedals", "eyeball"}));
-  simulate->add_option("--script", script, "script file (see drivers/sim/emulator.hpp); default: built-in")
-      ->check(CLI::ExistingFile);
+  simulate->add_option("--script", script, "script file (see drivers/sim/emulator.hpp); default: built-in");
   simulate->add_option("--link", link, "path of the serial link to create (symlink to the pty)");
   simulate->add_option("--can", sim_can, "simulate on this CAN interface instead of a pty");
   simulate->add_option("--node", sim_node, "CAN node id")->check(CLI::Range(1, 127));
   simulate->add_flag("--fd", sim_fd, "CAN FD frames");
-  simulate->add_option("--duration-s", sim_s, "stop after this long")->check(CLI::PositiveNumber);
+  simulate->add_option("--duration-s", sim_s, "stop after this long")->check(vitreo::app::finite_range(0.001, 1e9));
 
   try {
     app.parse(argc, argv);

@@ -2,8 +2,11 @@
 
 #include <toml++/toml.h>
 
+#include "rig/files/toml_guard.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <stdexcept>
 
@@ -43,6 +46,9 @@ bool PedalMapper::apply(const PedalReading& r) {
 }
 
 PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string& origin) {
+  // toml++ 3.3.0 has undefined behaviour on two kinds of malformed text (rig/files/toml_guard.hpp).
+  if (const files::TomlProblem bad = files::toml_guard(toml_text))
+    throw std::runtime_error(origin + ":" + std::to_string(bad.line) + ": column " + std::to_string(bad.column) + ": " + bad.why);
   toml::table root;
   try {
     root = toml::parse(toml_text, origin);
@@ -102,6 +108,23 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
     }
   }
   if (m.zoom_max < m.zoom_min) throw std::runtime_error(origin + ": pedals.zoom_max is below zoom_min");
+  // One switch or axis doing two jobs on the same pedal would fire both at once (reflux with every
+  // laser shot): refused, with both names. -1 means "none" and may repeat.
+  auto distinct = [&](const char* what, std::initializer_list<std::pair<const char*, int>> uses) {
+    for (auto a = uses.begin(); a != uses.end(); ++a) {
+      for (auto b = a + 1; b != uses.end(); ++b) {
+        if (a->second >= 0 && a->second == b->second)
+          throw std::runtime_error(origin + ": pedals." + a->first + " and pedals." + b->first + " are the same " + what + " (" +
+                                   std::to_string(a->second) + ")");
+      }
+    }
+  };
+  distinct("switch", {{"reflux_switch", m.reflux_switch}, {"laser_switch", m.laser_switch},
+                      {"instrument_switch", m.instrument_switch}, {"air_switch", m.air_switch}});
+  distinct("axis", {{"vacuum_axis", m.vacuum_axis}, {"cut_rate_axis", m.cut_rate_axis}});
+  distinct("switch", {{"light_up_switch", m.light_up_switch}, {"light_down_switch", m.light_down_switch}});
+  distinct("axis", {{"zoom_axis", m.zoom_axis}, {"focus_axis", m.focus_axis}});
+  distinct("pedal id", {{"vitrectomy_pedal_id", m.vitrectomy_pedal_id}, {"microscope_pedal_id", m.microscope_pedal_id}});
   if (m.cut_rate_max_cpm < m.cut_rate_min_cpm) throw std::runtime_error(origin + ": pedals.cut_rate_max_cpm is below cut_rate_min_cpm");
   return m;
 }

@@ -1,6 +1,8 @@
 // Scene files: every case in scenes/ loads, settles within its budget and has a stable state hash;
 // the corpus in bad/ gives the expected file:line errors; random mutations never crash.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -90,6 +92,33 @@ TEST(SceneFiles, CasesTheIssueAsksFor) {
       EXPECT_GE(d.materials.sources.at(m).size(), 4u) << f << " " << m;
     }
   }
+}
+
+// Issue 20: files a careless user can name — a case of 2 MB (it used to run and be copied into the
+// recording), a FIFO (reading blocks for ever), a directory — are refused at once with the reason.
+TEST(SceneFiles, OversizedSpecialAndDirectoryPathsAreRefusedAtOnceWithTheReason) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("vitreo-scene-files-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream big(dir / "big.toml");
+    big << "format_version = 1\nname = \"big\"\n";
+    for (int i = 0; i < 40000; ++i) big << "# padding padding padding padding padding padding\n";
+  }
+  ASSERT_EQ(::mkfifo((dir / "fifo.toml").c_str(), 0600), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const auto& [name, says] : {std::pair<const char*, const char*>{"big.toml", "larger than 1 MiB"},
+                                   {"fifo.toml", "not a regular file"}, {".", "is a directory"}, {"none.toml", "no such file"}}) {
+    const std::string path = (dir / name).string();
+    try {
+      (void)scene_io::read_case_text(path);
+      ADD_FAILURE() << path << " was read";
+    } catch (const scene_io::SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)scene_io::load_scene_file(path), scene_io::SceneError) << path;
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5)) << "nothing blocked or read gigabytes";
+  fs::remove_all(dir);
 }
 
 class BadScene : public ::testing::TestWithParam<std::string> {};
