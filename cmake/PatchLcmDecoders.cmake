@@ -5,15 +5,17 @@
 #   - a string is read as `if(len > maxlen - pos) return -1; s.assign(p, len - 1); pos += len;`, so a
 #     length of 0 throws std::length_error (assign of SIZE_MAX bytes) and a negative one (INT_MIN)
 #     passes the check, over-reads and moves `pos` backwards;
-#   - the NUL that ends every LCM string on the wire is never looked at;
+#   - the NUL that ends every LCM string on the wire is never looked at, and a NUL inside one is
+#     kept (the encoder stops at it, so the message is not what the bytes said);
 #   - a variable array is read as `v.resize(this->n)` with no check of n, so a negative count throws
 #     std::length_error and a huge one allocates before the data is found missing.
 # Debian bookworm ships only 1.3.1 (and we found no upstream release that checks either). This script
 # adds the checks: a string length must be at least 1 (it counts the terminating NUL), that NUL must
-# be there, and a count must be 0..bytes left (every element takes at least one byte on the wire).
-# It fails the build when the generated code does not look the way it expects (a changed lcm-gen),
-# rather than leave a decoder unpatched. The checked decoding layer (rig/telemetry/lcm_decode.hpp)
-# catches whatever is still thrown and is the only way vitreo decodes outside bytes.
+# be there and be the string's only one, and a count must be 0..bytes left (every element takes at
+# least one byte on the wire). It fails the build when the generated code does not look the way it
+# expects (a changed lcm-gen), rather than leave a decoder unpatched. The checked decoding layer
+# (rig/telemetry/lcm_decode.hpp) catches whatever is still thrown and is the only way vitreo decodes
+# outside bytes.
 if(NOT LCM_HEADERS)
   message(FATAL_ERROR "PatchLcmDecoders: pass -DLCM_HEADERS=<generated headers>")
 endif()
@@ -28,7 +30,7 @@ foreach(_file IN LISTS LCM_HEADERS)
   # Strings: every length check before an assign.
   string(REGEX MATCHALL "\\.assign\\(" _assigns "${_text}")
   string(REGEX REPLACE "if\\((__[A-Za-z0-9_]*len_*) > maxlen - pos\\) return -1;"
-                       "if(\\1 < 1 || \\1 > maxlen - pos || ((const char*)buf)[offset + pos + \\1 - 1] != 0) return -1;"
+                       "if(\\1 < 1 || \\1 > maxlen - pos || ((const char*)buf)[offset + pos + \\1 - 1] != 0 || memchr(((const char*)buf) + offset + pos, 0, \\1 - 1) != NULL) return -1;"
                        _text "${_text}")
   string(REGEX MATCHALL "< 1 \\|\\| __[A-Za-z0-9_]*len_* > maxlen - pos" _string_checks "${_text}")
   # Variable arrays: a count check before every resize.

@@ -6,12 +6,16 @@
 //     calls parse_key() on a character that is neither a bare-key character nor a quote, breaking
 //     parse_key's precondition (TOML_ASSERT_ASSUME: an assertion failure in a debug build, an
 //     optimiser assumption that does not hold in the release library).
-//  2. A non-ASCII character where the parser looks for whitespace — `fo µ = 1`: the generated
+//  2. A non-ASCII character where the parser looks for whitespace — `fo µ = 1`, `a = 1µ`, and right
+//     after a multi-line string's line-ending backslash (`"""\<newline> µ"""`): the generated
 //     is_non_ascii_horizontal_whitespace() reaches TOML_UNREACHABLE (__builtin_unreachable) for
 //     code points U+00A1..U+049A and several other ranges its bit table leaves out.
 //
-// Both are refused here with a line and column instead. Neither can be valid TOML 1.0: a header's
-// key starts with [A-Za-z0-9_-] or a quote, and outside strings and comments TOML is ASCII. The
+// These are refused here with a line and column instead, and so are control characters (TOML has
+// none but tab outside escapes; a NUL made toml++ and this scan disagree about where a string is).
+// None of it can be valid TOML 1.0: a header's key starts with [A-Za-z0-9_-] or a quote, outside
+// strings and comments TOML is ASCII, and a line-ending backslash's whitespace ends at a character
+// that starts the string's next content, which is fine to require ASCII of. The
 // fuzz target tests/fuzz (toml) runs toml++ header-only with its assertions on and UBSan behind this
 // guard. Upstream: marzer/tomlplusplus PR #301 fixes the `[[[` form of (1) after 3.3.0.
 #include <string>

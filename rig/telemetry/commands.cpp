@@ -102,8 +102,8 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
   } else if (word == "z" || word == "zoom") {
     char* end = nullptr;
     const double v = arg.empty() ? 0.0 : std::strtod(arg.c_str(), &end);
-    if (arg.empty() || end == arg.c_str() || *end != '\0') {
-      out.error = "zoom needs a number, e.g. 'zoom 12.5'";
+    if (arg.empty() || end == arg.c_str() || *end != '\0' || !std::isfinite(v)) {
+      out.error = "zoom needs a finite number, e.g. 'zoom 12.5'";
     } else {
       c.command = static_cast<std::int8_t>(CommandCode::Zoom);
       c.value = v;

@@ -220,7 +220,8 @@ TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
   }
   // A snapshot name is checked whole: 70 characters were cut to 64 and accepted on the terminal.
   for (const char* bad : {"", "   ", "zoom", "zoom x", "zoom 3x", "save", "n 3", "fly",
-                          "s aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa", "s ../x", "s .hidden"}) {
+                          "s aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa", "s ../x", "s .hidden",
+                          "zoom nan", "zoom inf", "z -inf", "zoom 1e999"}) {
     const ParsedCommand p = parse_command_line(bad, "terminal", 1);
     EXPECT_FALSE(p.ok) << "'" << bad << "' parsed";
     EXPECT_FALSE(p.error.empty());

@@ -96,6 +96,14 @@ TEST(LcmDecode, AStringWithoutItsTerminatingNulIsRefused) {
   EXPECT_EQ(decode<Cmd>(b), DecodeError::Malformed);
 }
 
+// Found by the fuzzer: a NUL inside a string decoded, then re-encoded shorter (the encoder stops
+// at the first NUL) — bytes that did not say what the message said.
+TEST(LcmDecode, AStringWithANulInsideIsRefused) {
+  LcmBytes b;
+  b.i64(Cmd::getHash()).i64(1).str_len(4).raw(std::string("a\0b", 3)).i8(0).i64(1).i8(Cmd::PAUSE).f64(0).str("");
+  EXPECT_EQ(decode<Cmd>(b), DecodeError::Malformed);
+}
+
 TEST(LcmDecode, NegativeOrImpossibleArrayCountsAreRefused) {
   for (std::int16_t n : {std::int16_t{-1}, std::int16_t{-32768}, std::int16_t{32767}, std::int16_t{3}}) {
     LcmBytes b;
