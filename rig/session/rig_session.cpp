@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <csignal>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <algorithm>
@@ -155,6 +154,13 @@ std::vector<std::string> score_lines(SimulationModel& model) {
 
 SessionSummary run_session(const SessionConfig& config) {
   if (config.model.cases.empty()) throw std::invalid_argument("run_session: no case to run");
+  // spdlog's registry (the default logger) is a function-local static inside Debian's libspdlog,
+  // which is not built for ThreadSanitizer: when a session thread logged first, the other threads'
+  // reads of the logger looked unordered to TSan (its fast path is an atomic it cannot see). It is
+  // no race — C++ makes the static's initialisation thread-safe — but creating it here, before any
+  // session thread starts, gives it an order TSan can see (thread creation) and keeps the report
+  // of a real race readable.
+  (void)spdlog::default_logger_raw();
   CaseSwitcher switcher(config.model.cases, config.model.load, config.render);
   // The first case is loaded here, before any thread starts (a bad case stops the session now).
   std::unique_ptr<PreparedCase> first = switcher.load_now(config.model.first_case);
@@ -219,14 +225,13 @@ SessionSummary run_session(const SessionConfig& config) {
   harness_config.loop.period_ns = static_cast<std::int64_t>(config.model.dt_s * 1e9);
   harness_config.max_steps = config.steps;
   harness_config.physics_realtime = config.realtime;
-  const runtime::FixedStepLoop* loop = nullptr;  // the harness's loop; set before start()
+  runtime::FixedStepLoop* loop = nullptr;        // the harness's loop; set before start()
   std::unique_ptr<PreparedCase> retiring;        // a replaced case waiting for room in the ring
   // Case switches for the summary: fixed slots written by physics, read after it stopped.
   constexpr std::size_t kMaxSwitchLog = 64;
   std::array<std::pair<std::uint64_t, int>, kMaxSwitchLog> switch_log{};
   std::size_t switches = 0;
 
-  runtime::FixedStepLoop* physics_loop = nullptr;  // set before start(): the step ends it after a stop request
   int stopped_by = 0;                              // the signal that ended the session early (physics thread)
   runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
@@ -314,11 +319,10 @@ SessionSummary run_session(const SessionConfig& config) {
     }
     if (last && stop != 0) {
       stopped_by = stop;
-      physics_loop->request_stop();
+      loop->request_stop();
     }
   });
   loop = &harness.loop();
-  physics_loop = &harness.loop();
   std::int64_t next_receive_status_ns = 0;
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();

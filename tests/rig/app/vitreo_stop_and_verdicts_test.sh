@@ -23,10 +23,11 @@ wait_running() {
   return 1
 }
 
-echo "--- SIGTERM mid-session"
+echo "--- SIGTERM mid-session (after the whole process was stopped for 0.3 s: its device reader starves)"
 run --duration 60 --out "$tmp/term" >"$tmp/term.out" 2>&1 &
 rig=$!
 wait_running "$tmp/term/session.lcmlog" || { cat "$tmp/term.out"; echo "FAIL: the session never started"; exit 1; }
+kill -STOP $rig; sleep 0.3; kill -CONT $rig; sleep 0.5
 kill -TERM $rig
 rc=0; wait $rig || rc=$?; rig=
 grep -v '^\[' "$tmp/term.out"
@@ -34,6 +35,7 @@ check "exit 0 after SIGTERM" '[ $rc -eq 0 ]'
 check "the summary says why it ended" 'grep -q "stopped early by SIGTERM" "$tmp/term.out"'
 check "the summary is printed in full" 'grep -q "state hash" "$tmp/term.out" && grep -q "score" "$tmp/term.out"'
 check "the check replay reached the same state" 'grep -q "identical final state and score" "$tmp/term.out"'
+check "the summary says the device reader was starved" 'grep -q "sensor faults    driver thread starved [1-9][0-9]* times (longest [0-9]* ms)" "$tmp/term.out"'
 rc=0; "$vitreo" --replay "$tmp/term/session.lcmlog" >"$tmp/replay.out" 2>&1 || rc=$?
 cat "$tmp/replay.out"
 check "--replay: complete, identical to the recorded final state, exit 0" \

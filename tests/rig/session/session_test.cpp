@@ -262,6 +262,20 @@ TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilIt
   std::filesystem::remove(config.record_path);
 }
 
+// Issue 20: framing errors and sequence gaps were counted in telemetry but absent from the console
+// summary. A tracker whose line corrupts bytes now has its own fault line there.
+TEST(RigSession, LinkFaultsAppearInTheSummaryPerDevice) {
+  auto config = small_session("faults", 800);
+  config.devices[0].sim_script = std::string(kTracker) + "corrupt 0.003\nseed 5\n";
+  const rig::SessionSummary live = rig::run_session(config);
+  std::string faults;
+  for (const auto& l : live.fault_lines) faults += l + "\n";
+  EXPECT_NE(faults.find("tracker-0: "), std::string::npos) << faults;
+  EXPECT_NE(faults.find("frames missing (sequence gaps)"), std::string::npos) << faults;
+  EXPECT_EQ(faults.find("pedals: "), std::string::npos) << "the clean device has no fault line:\n" << faults;
+  std::filesystem::remove(config.record_path);
+}
+
 TEST(RigSession, RendersStereoFramesOfTheRunAndTheLastOne) {
   auto config = small_session("render", 600);
   config.render = true;
