@@ -38,6 +38,16 @@ using namespace vitreo;
 
 namespace {
 
+// Under ThreadSanitizer the physics step runs many times slower than the emulated devices, whose
+// clocks are the wall clock: a fault of 800 ms of device time then covers a few dozen steps, not
+// 800, and host receive times bunch up. That build looks for races; the timing bounds below are
+// held by the plain and ASan builds.
+#if defined(__SANITIZE_THREAD__)
+constexpr bool kPhysicsKeepsUpWithDevices = false;
+#else
+constexpr bool kPhysicsKeepsUpWithDevices = true;
+#endif
+
 const char* kTracker =
     "device tracker\nrate_hz 1000\nserial 1001\ntool 3\ninstrument 0\n"
     "key 0 -12.5 3.7 6.2 0 0 0 0\nkey 500 -8 0.5 -4.5 0 0 0 0\nkey 1000 -7 -1.5 -3.5 0 0 20 1\n"
@@ -205,7 +215,7 @@ TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilIt
   auto config = small_session("stuck", 2500);
   config.devices[0].sim_script = std::string(kTracker) + "fault 700 800 stuck\n";
   const rig::SessionSummary live = rig::run_session(config);
-  EXPECT_GT(live.frozen_steps, 500u);
+  EXPECT_GT(live.frozen_steps, kPhysicsKeepsUpWithDevices ? 500u : 0u);
   std::string faults;
   for (const auto& l : live.fault_lines) faults += l + "\n";
   EXPECT_NE(faults.find("tracker-0: 1 time stuck (instrument frozen)"), std::string::npos) << faults;
@@ -229,8 +239,10 @@ TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilIt
   ASSERT_GE(first_same_us, 0) << "the fault's identical poses are in the recording";
   ASSERT_GE(stuck_us, 0) << "the stuck report is in the recording";
   std::printf("stuck reported %.1f ms after the first identical pose\n", static_cast<double>(stuck_us - first_same_us) * 1e-3);
-  EXPECT_GE(stuck_us - first_same_us, 50'000) << "not before 50 ms of identical poses";
-  EXPECT_LE(stuck_us - first_same_us, 100'000) << "reported within 100 ms";
+  if (kPhysicsKeepsUpWithDevices) {
+    EXPECT_GE(stuck_us - first_same_us, 50'000) << "not before 50 ms of identical poses";
+    EXPECT_LE(stuck_us - first_same_us, 100'000) << "reported within 100 ms";
+  }
   EXPECT_GT(up_us, stuck_us) << "moving again ends it";
 
   // Telemetry: the status said stuck, and the instrument was frozen, then moved again.
@@ -255,7 +267,7 @@ TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilIt
     }
   }
   EXPECT_TRUE(saw_stuck) << "VITREO_DEVICE_STATUS reported the stuck tracker";
-  EXPECT_GT(frozen_states, 100) << "the instrument was frozen while its tracker was stuck";
+  EXPECT_GT(frozen_states, kPhysicsKeepsUpWithDevices ? 100 : 0) << "the instrument was frozen while its tracker was stuck";
   EXPECT_TRUE(moving_after_frozen);
   const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
   EXPECT_EQ(replay.state_hash, live.state_hash) << "the freeze is recorded, so the replay freezes too";
@@ -272,7 +284,11 @@ TEST(RigSession, LinkFaultsAppearInTheSummaryPerDevice) {
   for (const auto& l : live.fault_lines) faults += l + "\n";
   EXPECT_NE(faults.find("tracker-0: "), std::string::npos) << faults;
   EXPECT_NE(faults.find("frames missing (sequence gaps)"), std::string::npos) << faults;
-  EXPECT_EQ(faults.find("pedals: "), std::string::npos) << "the clean device has no fault line:\n" << faults;
+  // A starved reader loses bytes of the clean device too (issue 20 saw it on a loaded machine); the
+  // summary then says so, and that is the line that explains a pedal fault line.
+  if (faults.find("driver thread starved") == std::string::npos) {
+    EXPECT_EQ(faults.find("pedals: "), std::string::npos) << "the clean device has no fault line:\n" << faults;
+  }
   std::filesystem::remove(config.record_path);
 }
 
