@@ -81,6 +81,7 @@ InstrumentSystem::InstrumentSystem(TissueWorld& world, InstrumentSceneOptions op
   events_.reserve(256);
   burns_.reserve(4096);
   sweeps_.reserve(n);
+  poses_.reserve(n);
   removals_.reserve(n);
 }
 
@@ -377,6 +378,7 @@ InstrumentStepReport InstrumentSystem::step(double dt) {
   if (probe_) probe_(0, probe_user_);
   events_.clear();
   sweeps_.clear();
+  poses_.clear();
   removals_.clear();
   suction_.clear();
   solve_eye_rotation();
@@ -395,8 +397,10 @@ InstrumentStepReport InstrumentSystem::step(double dt) {
   update_light(dt);
   for (std::uint32_t i = 0; i < state_.size(); ++i) {
     const InstrumentState& st = state_[i];
-    if (!st.inside) continue;
     const auto kind = st.description.kind;
+    const bool cuts = kind == InstrumentKind::kBlade || kind == InstrumentKind::kSidewaysBlade || kind == InstrumentKind::kScissors;
+    if (cuts && (st.inside || was_inside_[i])) poses_.push_back(cutting_pose(i));
+    if (!st.inside) continue;
     if (kind == InstrumentKind::kVitrector && st.input.pedal > 0.0) {
       const double field = std::max(options_.vitrector_field_mm * st.input.pedal, options_.vitrector_removal_mm);
       suction_.push_back({st.tip.port_center, st.tip.port_normal, field, options_.vitrector_suction_pa * st.input.pedal});
@@ -474,7 +478,7 @@ void InstrumentSystem::after_step(const StepReport& report, double dt) {
   }
   rigid_contacts();
   if (topology_) {
-    for (const auto& s : sweeps_) topology_->cut(world_, s);
+    for (const auto& p : poses_) topology_->cut(world_, p);
     for (const auto& r : removals_) topology_->remove(world_, r);
   }
   for (std::uint32_t i = 0; i < state_.size(); ++i) {
@@ -482,6 +486,26 @@ void InstrumentSystem::after_step(const StepReport& report, double dt) {
     previous_tip_[i] = state_[i].tip;
     was_inside_[i] = state_[i].inside ? 1 : 0;
   }
+}
+
+CuttingPose InstrumentSystem::cutting_pose(std::uint32_t i) const {
+  const InstrumentState& st = state_[i];
+  CuttingPose p;
+  p.instrument = i;
+  p.kind = st.description.kind;
+  p.in_eye = st.inside;
+  p.a = st.tip.edge_a;
+  p.b = st.tip.edge_b;
+  if (p.kind == InstrumentKind::kScissors) {
+    // The jaws lie in the (u, v) plane of the frame, at ± half the opening about u (tip_geometry).
+    const InstrumentDimensions& dim = st.description.dimensions;
+    p.hinge = st.tip.hinge;
+    p.bisector = st.frame.u;
+    p.normal = st.frame.u.cross(st.frame.v);
+    p.opening_rad = 2.0 * dim.jaw_open_deg * std::numbers::pi / 180.0 * (1.0 - std::clamp(st.input.actuation, 0.0, 1.0));
+    p.jaw_length_mm = dim.jaw_length_mm;
+  }
+  return p;
 }
 
 Vec3 InstrumentSystem::burn_position(const BurnSpot& b) const {

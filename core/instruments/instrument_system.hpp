@@ -5,10 +5,11 @@
 // core/collision) and the grasps, suction and adhesions to the TissueWorld, steps it, and reports
 // contact forces, iatrogenic events, laser burns, the fluid level and the eye rotation.
 //
-// Cutting and removal are topology changes, which belong to core/topology: the blades, scissors and
-// vitrector describe what they sweep or draw in (BladeSweep, RemovalRequest) and hand it to a
-// TopologyActions implementation at the step boundary; without one the requests are still listed
-// each step for the rig and the tests.
+// Cutting and removal are topology changes, which belong to core/topology: the blades and scissors
+// hand their cutting edges' pose every step (CuttingPose: core/topology follows each incision pose by
+// pose, so what is cut does not depend on the step length) and the vitrector what it draws in
+// (RemovalRequest) to a TopologyActions implementation at the step boundary; without one they are
+// still listed each step for the rig and the tests, with each blade's swept quad (BladeSweep).
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -33,6 +34,22 @@ struct BladeSweep {
   Vec3 a1 = Vec3::Zero(), b1 = Vec3::Zero();  // edge at the end of the step
 };
 
+// A cutting instrument's edges at the end of a step, handed over every step while it is in the eye
+// and once more, with in_eye false, the step it leaves (its incisions end there).
+struct CuttingPose {
+  std::uint32_t instrument = 0;
+  InstrumentKind kind = InstrumentKind::kBlade;
+  bool in_eye = true;
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();  // blades: the sharp edge (eye frame)
+  // Scissors: the hinge, the bisector of the jaws and the normal of their plane, the opening between
+  // the jaws (rad) and their length.
+  Vec3 hinge = Vec3::Zero();
+  Vec3 bisector = Vec3::UnitX();
+  Vec3 normal = Vec3::UnitZ();
+  double opening_rad = 0.0;
+  double jaw_length_mm = 0.0;
+};
+
 // Vitrector removal for one step: tissue inside the removal hemisphere (radius, in front of the port
 // along its normal) is cut away at the cut rate; suction (the outer hemisphere) is already applied.
 struct RemovalRequest {
@@ -47,11 +64,11 @@ struct RemovalRequest {
 };
 
 // Consumer of cuts and removals: core/topology implements it (the adapter point). Called after
-// TissueWorld::step, at the step boundary, once per sweep/request.
+// TissueWorld::step, at the step boundary, once per cutting pose/request.
 class TopologyActions {
  public:
   virtual ~TopologyActions() = default;
-  virtual void cut(TissueWorld& world, const BladeSweep& sweep) = 0;
+  virtual void cut(TissueWorld& world, const CuttingPose& pose) = 0;
   virtual void remove(TissueWorld& world, const RemovalRequest& request) = 0;
 };
 
@@ -210,6 +227,7 @@ class InstrumentSystem {
   const std::vector<InstrumentEvent>& events() const { return events_; }
   const std::vector<BurnSpot>& burns() const { return burns_; }
   const std::vector<BladeSweep>& blade_sweeps() const { return sweeps_; }
+  const std::vector<CuttingPose>& cutting_poses() const { return poses_; }
   const std::vector<RemovalRequest>& removal_requests() const { return removals_; }
   const EyeRotation& eye_rotation() const { return eye_; }
   const LightExposure& light() const { return light_; }
@@ -230,6 +248,7 @@ class InstrumentSystem {
   void update_fluid(double dt);
   void update_light(double dt);
   void rigid_contacts();
+  CuttingPose cutting_pose(std::uint32_t instrument) const;
   void after_step(const StepReport& report, double dt);
   void emit(InstrumentEventKind kind, std::uint32_t instrument, std::uint32_t other, const Vec3& p, double magnitude);
 
@@ -258,6 +277,7 @@ class InstrumentSystem {
   std::vector<InstrumentEvent> events_;
   std::vector<BurnSpot> burns_;
   std::vector<BladeSweep> sweeps_;
+  std::vector<CuttingPose> poses_;
   std::vector<RemovalRequest> removals_;
   std::vector<std::uint8_t> pair_touching_, lens_touching_, wall_touching_, retina_overloaded_;
 };

@@ -8,6 +8,7 @@
 #include "core/instruments/instrument_system.hpp"
 #include "core/instruments/topology_adapter.hpp"
 #include "test_meshes.hpp"
+#include "../topology/mesh_topology.hpp"
 
 using namespace vitreo::core;
 
@@ -661,8 +662,15 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
     ASSERT_TRUE(sys.set_input(0, at(-1.0 + 2.0 * i / 200.0, -0.4)));
     ASSERT_TRUE(sys.step(kDt).tissue.ok);
   }
+  // Out of the eye: the incision ends where the blade was (until then its last piece is the
+  // crack's, not yet cut).
+  InstrumentInput out = at(1.0, -0.4);
+  out.present = false;
+  ASSERT_TRUE(sys.set_input(0, out));
+  ASSERT_TRUE(sys.step(kDt).tissue.ok);
   EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
-  EXPECT_GT(topology.springs_opened(), 10u);
+  // y = 0 is a row of springs of this mesh: the cut opens the ten between x = −1 and 1.
+  EXPECT_GE(topology.springs_opened(), 10u);
   const Surface& s = world.surface(m);
   ASSERT_GT(s.vertex_slots(), before);
   // Every vertex the cut made lies on the blade's path (x from −1 to 1 along y = 0).
@@ -671,6 +679,107 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
     EXPECT_LT(std::abs(s.rest_position(v).y()), 0.05) << v;
     EXPECT_GT(s.rest_position(v).x(), -1.1);
     EXPECT_LT(s.rest_position(v).x(), 1.1);
+  }
+}
+
+// A tracked blade at 5 mm/s moves 5 µm per 1 ms step: the incision the adapter keeps for it cuts
+// one slit along the whole path (before incisions, each step's sweep was cut on its own and such
+// steps left separate slits or none), and the blade leaving the eye ends it where it last was.
+TEST(Instruments, ABladeAt5mmPerSecondCutsOneSlitAndLeavingTheEyeEndsIt) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
+  anchor_border(world.surface(m), 4.0);
+  TopologyAdapter topology(world, {m}, {});
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
+  sys.set_topology(&topology);
+  auto at = [&](double x, double z) {
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z);
+    in.tip_fixture_mm.x() += x;
+    return in;
+  };
+  // Plunge through the membrane at x = −0.9, then 1.6 mm along +x at 5 mm/s, then out of the eye.
+  for (int i = 0; i <= 50; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-0.9, 0.6 - 1.0 * i / 50.0)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  for (int i = 1; i <= 320; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-0.9 + 0.005 * i, -0.4)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  InstrumentInput out = at(0.7, -0.4);
+  out.present = false;
+  ASSERT_TRUE(sys.set_input(0, out));
+  ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
+  EXPECT_EQ(topology.gaps(), 0u);
+  const Surface& s = world.surface(m);
+  const test::CornerTopology t = test::corner_topology(s);
+  EXPECT_TRUE(t.ok()) << t.describe();
+  EXPECT_EQ(t.components, 1u) << t.describe();
+  EXPECT_EQ(t.boundary_loops, 2u) << "one slit: " << t.describe();
+  // The slit runs from x = −0.9 to 0.7 along y = 0: its ends are there (in the rest shape).
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+    if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
+    for (auto v : s.edge_vertices(e)) {
+      const Vec3& p = s.rest_position(v);
+      if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;  // the border
+      EXPECT_LT(std::abs(p.y()), 0.02) << "on the path";
+      lo = std::min(lo, p.x());
+      hi = std::max(hi, p.x());
+    }
+  }
+  EXPECT_NEAR(lo, -0.9, 0.02);
+  EXPECT_NEAR(hi, 0.7, 0.02) << "the cut ends where the blade left";
+}
+
+// Scissors closing on a membrane in small steps of the handle cut between where the open jaws
+// pierced it (before, the instrument handed over a quad along the closing jaws' own line, which
+// swept no area: the rig's scissors never cut).
+TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
+  for (const int steps : {1, 200}) {
+    SCOPED_TRACE(std::to_string(steps) + " steps");
+    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+    const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
+    anchor_border(world.surface(m), 4.0);
+    TopologyAdapter topology(world, {m}, {});
+    InstrumentSceneOptions o;
+    o.ports_mm = {Vec3(0, 0, 10)};
+    InstrumentSystem sys(world, o, {{InstrumentKind::kScissors, Gauge::k23, 0, {}}});
+    sys.set_topology(&topology);
+    // The hinge 0.3 mm above the membrane (the tip is a jaw length below it), jaws open in the
+    // x–z plane: each jaw pierces it 0.3 · tan 25° = 0.14 mm from under the hinge.
+    const double jaw = InstrumentDimensions{}.jaw_length_mm, half = InstrumentDimensions{}.jaw_open_deg * std::numbers::pi / 180.0;
+    auto at = [&](double actuation) { return down_to(0.3 - jaw, actuation); };
+    for (int i = 0; i <= 20; ++i) {
+      ASSERT_TRUE(sys.set_input(0, at(0.0)));
+      ASSERT_TRUE(sys.step(kDt).tissue.ok);
+    }
+    for (int i = 1; i <= steps; ++i) {
+      ASSERT_TRUE(sys.set_input(0, at(static_cast<double>(i) / steps)));
+      ASSERT_TRUE(sys.step(kDt).tissue.ok);
+    }
+    EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
+    EXPECT_EQ(topology.gaps(), 0u);
+    const Surface& s = world.surface(m);
+    const test::CornerTopology t = test::corner_topology(s);
+    EXPECT_EQ(t.components, 1u) << t.describe();
+    EXPECT_EQ(t.boundary_loops, 2u) << "one slit between the jaws: " << t.describe();
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+      if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
+      for (auto v : s.edge_vertices(e)) {
+        const Vec3& p = s.rest_position(v);
+        if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;
+        EXPECT_LT(std::abs(p.y()), 0.02);
+        lo = std::min(lo, p.x());
+        hi = std::max(hi, p.x());
+      }
+    }
+    EXPECT_NEAR(lo, -0.3 * std::tan(half), 0.02);
+    EXPECT_NEAR(hi, 0.3 * std::tan(half), 0.02);
   }
 }
 
