@@ -88,9 +88,10 @@ struct LinkStats {
   std::uint64_t drops = 0;            // frames missing according to the sequence counter
   std::uint64_t timestamp_jumps = 0;  // device clock stepped backwards or far forwards
   std::uint64_t stuck_samples = 0;
+  std::uint64_t identity_rejected = 0;  // DEVICE_INFO of another kind or serial than the rig expects
   std::uint64_t samples_delivered = 0;
   std::uint64_t disconnects = 0;
-  std::uint64_t reconnects = 0;
+  std::uint64_t reconnects = 0;       // the device identified itself again after a loss
   std::uint64_t latency_count = 0;
   std::uint64_t latency_last_us = 0;
   std::uint64_t latency_max_us = 0;
@@ -134,6 +135,10 @@ struct SessionConfig {
   std::uint64_t jump_tolerance_us = 100'000;   // device timestamp step counted as a jump
   std::uint16_t sample_rate_hz = 1000;
   std::uint32_t stuck_after = 200;             // identical consecutive samples before "stuck"
+  // Identity the rig expects at this address (0: any). A device announcing another kind or serial
+  // is not configured: the wrong tracker plugged into the tracker's port must not drive the forceps.
+  std::uint8_t expected_device_type = 0;       // vp_device_type
+  std::uint32_t expected_serial = 0;
 };
 
 class DeviceSession {
@@ -191,6 +196,7 @@ class DeviceSession {
   vp_device_info info_{};
   bool have_info_ = false;
   bool configured_ = false;
+  bool recovering_ = false;  // the transport was re-opened after a loss; the device not identified yet
   ClockMapper clock_;
   std::uint64_t last_frame_us_ = 0, last_sample_us_ = 0, state_since_us_ = 0;
   std::uint64_t next_retry_us_ = 0, next_sync_us_ = 0, next_reconnect_us_ = 0;

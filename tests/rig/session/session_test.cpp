@@ -63,7 +63,8 @@ rig::SessionConfig small_session(const std::string& tag, std::uint64_t steps) {
   c.steps = steps;
   c.lcm_url = "file://" + temp_path(tag + "-telemetry.lcmlog") + "?mode=w";
   c.record_path = temp_path(tag + "-session.lcmlog");
-  c.devices = {{"tracker-0", temp_path(tag + "-tracker"), 1, 0, kTracker}, {"pedals", temp_path(tag + "-pedals"), 2, 0, kPedals}};
+  c.devices = {{"tracker-0", rig::DeviceRole::tracker, "sim:tracker?transport=pty&link=" + temp_path(tag + "-tracker"), 1, 0, 0, 0, kTracker},
+               {"pedals", rig::DeviceRole::pedals, "sim:pedals?transport=pty&link=" + temp_path(tag + "-pedals"), 2, 0, 0, 0, kPedals}};
   return c;
 }
 
