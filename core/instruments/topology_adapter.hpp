@@ -1,8 +1,8 @@
 #pragma once
 // The adapter between the instruments' cut and removal requests and core/topology: blades and
 // scissors cut through Cutter (the swept-quad cut), the vitrector removes through Vitrector's
-// guillotine. Suction itself is applied by the solver (SuctionField), so the adapter runs the
-// topology vitrector with zero attraction and only its cutter.
+// guillotine. Suction itself is applied by the solver (SuctionField); build the adapter with the
+// instruments' VitrectorSettings (InstrumentSceneOptions::vitrector) so both use one model.
 #include <cstdint>
 #include <memory>
 #include <vector>

@@ -194,7 +194,7 @@ bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSn
     }
   }
   // Instruments as the simulation placed them (eye frame, after the eye's rotation).
-  const core::InstrumentSystem& sys = model.instrument_system();
+  const core::Simulation& sys = model.simulation();
   constexpr std::uint32_t kSlots = sizeof(out.instruments) / sizeof(out.instruments[0]);
   for (std::uint32_t i = 0; i < kSlots; ++i) {
     auto& o = out.instruments[i];

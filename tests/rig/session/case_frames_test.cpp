@@ -330,8 +330,8 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   model.step();
   ASSERT_TRUE(model.apply(pedal(0)));
   model.step();
-  ASSERT_EQ(model.instrument_system().burns().size(), 1u) << "one pulse on the rising edge";
-  const core::Vec3 hit = model.instrument_system().burn_position(model.instrument_system().burns()[0]);
+  ASSERT_EQ(model.simulation().burns().size(), 1u) << "one pulse on the rising edge";
+  const core::Vec3 hit = model.simulation().burn_position(model.simulation().burns()[0]);
   rig::ViewSnapshot view;
   ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
   ASSERT_EQ(view.n_burns, 1u);
@@ -382,9 +382,9 @@ TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
   ASSERT_TRUE(model.apply(pedal(1.0, 0)));       // full aspiration
   ASSERT_TRUE(model.controls().air_infusion);
   model.step();
-  const double top = model.instrument_system().fluid_level_z_mm();
+  const double top = model.simulation().fluid_level_z_mm();
   for (int i = 0; i < 400; ++i) model.step();
-  const double level = model.instrument_system().fluid_level_z_mm();
+  const double level = model.simulation().fluid_level_z_mm();
   std::printf("fluid level: %.2f mm at the start of the exchange, %.2f mm after 0.4 s of aspiration\n", top, level);
   EXPECT_NEAR(top - level, 0.4 * 2.0, 0.1) << "falls at the aspiration rate (2 mm/s at full vacuum)";
   rig::ViewSnapshot v1;

@@ -272,7 +272,7 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   EXPECT_EQ(c.tools[0], core::InstrumentKind::kForceps);
   EXPECT_EQ(c.tools[3], core::InstrumentKind::kVitrector);
   EXPECT_EQ(c.light_pipe, 4);
-  EXPECT_EQ(model.instrument_system().instrument_count(), 5u);
+  EXPECT_EQ(model.simulation().instrument_count(), 5u);
   // The tool pivots in the eye model's working_1 sclerotomy: between its outer and inner openings.
   const core::SclerotomyPort* w1 = nullptr;
   for (const auto& p : scene.eye.ports) {
@@ -295,11 +295,11 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   in.values[10] = 3.0;  // tool type
   ASSERT_TRUE(model.apply(in));
   model.step();
-  EXPECT_TRUE(model.instrument_system().instrument(0).input.present);
-  EXPECT_TRUE(model.instrument_system().instrument(0).inside);
-  EXPECT_FALSE(model.instrument_system().instrument(1).input.present);
+  EXPECT_TRUE(model.simulation().instrument(0).input.present);
+  EXPECT_TRUE(model.simulation().instrument(0).inside);
+  EXPECT_FALSE(model.simulation().instrument(1).input.present);
   // Where the tracker put it (the eye turns only slightly under the port's push).
-  EXPECT_LT((model.instrument_system().instrument(0).frame.tip - tip).norm(), 0.5);
+  EXPECT_LT((model.simulation().instrument(0).frame.tip - tip).norm(), 0.5);
 }
 
 TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
