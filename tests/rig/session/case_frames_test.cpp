@@ -335,9 +335,25 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   rig::ViewSnapshot view;
   ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
   ASSERT_EQ(view.n_burns, 1u);
+  // Handed over as surface coordinates: the burnt triangle's corners and the point in it, which lies
+  // where the simulation says the spot is now.
+  const rig::BurnSnapshot& spot = view.burns[0];
+  ASSERT_TRUE(spot.on_triangle);
+  const rig::SurfaceSnapshot& surf = view.surfaces[spot.surface];
+  core::Vec3 at = core::Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    for (int axis = 0; axis < 3; ++axis) at[axis] += spot.barycentric[k] * surf.xyz[3 * spot.corners[k] + static_cast<std::uint32_t>(axis)];
+  }
+  EXPECT_LT((at - hit).norm(), 1e-4);
   const vr::FrameScene after = builder.build(view);
   std::size_t burns = 0;
-  for (const auto& m : after.meshes) burns += m.burns.size();
+  for (const auto& m : after.meshes) {
+    burns += m.burns.size();
+    for (const auto& b : m.burns) {
+      EXPECT_TRUE(b.hit_point.has_value()) << "the renderer gets the triangle, not a point to search for";
+      EXPECT_FALSE(b.hit_position_mm.has_value());
+    }
+  }
   EXPECT_EQ(burns, 1u);
   vr::FrameScene cleared = after;
   for (auto& m : cleared.meshes) m.burns.clear();
