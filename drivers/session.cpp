@@ -1,6 +1,7 @@
 #include "drivers/session.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 
 namespace vitreo::drivers {
@@ -27,14 +28,14 @@ std::string to_string(const LinkStats& s) {
   char b[640];
   std::snprintf(b, sizeof b,
                 "bytes=%llu frames=%llu valid=%llu crc=%llu framing=%llu version=%llu unknown=%llu length=%llu "
-                "range=%llu drops=%llu ts_jumps=%llu stuck=%llu stuck_episodes=%llu delivered=%llu disconnects=%llu reconnects=%llu "
+                "range=%llu drops=%llu ts_jumps=%llu stuck=%llu stuck_episodes=%llu identity=%llu delivered=%llu disconnects=%llu reconnects=%llu "
                 "latency_us(last/mean/max)=%llu/%.0f/%llu",
                 (unsigned long long)s.bytes, (unsigned long long)s.frames, (unsigned long long)s.valid,
                 (unsigned long long)s.crc_errors, (unsigned long long)s.framing_errors,
                 (unsigned long long)s.version_errors, (unsigned long long)s.unknown_type,
                 (unsigned long long)s.length_errors, (unsigned long long)s.range_rejected,
                 (unsigned long long)s.drops, (unsigned long long)s.timestamp_jumps,
-                (unsigned long long)s.stuck_samples, (unsigned long long)s.stuck_episodes,
+                (unsigned long long)s.stuck_samples, (unsigned long long)s.stuck_episodes, (unsigned long long)s.identity_rejected,
                 (unsigned long long)s.samples_delivered,
                 (unsigned long long)s.disconnects, (unsigned long long)s.reconnects,
                 (unsigned long long)s.latency_last_us, s.latency_mean_us, (unsigned long long)s.latency_max_us);
@@ -130,7 +131,9 @@ void DeviceSession::send_configure(std::uint64_t now_us) {
 }
 
 void DeviceSession::transport_up(std::uint64_t now_us) {
-  if (state_ == LinkState::reconnecting || stats_.disconnects > 0) ++stats_.reconnects;
+  // a reconnect is counted when the device identifies itself on the re-opened transport: re-opening
+  // a CAN socket or a pty link succeeds whether or not the device is there
+  recovering_ = state_ == LinkState::reconnecting || stats_.disconnects > 0;
   have_info_ = false;
   configured_ = false;
   last_seq_ = -1;
@@ -199,8 +202,22 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
         last_error_ = "device announces an unsupported protocol major version";
         return;
       }
+      if ((cfg_.expected_device_type != 0 && m.u.device_info.device_type != cfg_.expected_device_type) ||
+          (cfg_.expected_serial != 0 && m.u.device_info.serial != cfg_.expected_serial)) {
+        ++stats_.identity_rejected;
+        char why[128];
+        std::snprintf(why, sizeof why, "device is type %u serial %u, expected type %u serial %u (0 = any)",
+                      static_cast<unsigned>(m.u.device_info.device_type), static_cast<unsigned>(m.u.device_info.serial),
+                      static_cast<unsigned>(cfg_.expected_device_type), static_cast<unsigned>(cfg_.expected_serial));
+        last_error_ = why;
+        return;
+      }
       info_ = m.u.device_info;
       have_info_ = true;
+      if (recovering_) {
+        ++stats_.reconnects;
+        recovering_ = false;
+      }
       if (state_ == LinkState::connecting) {
         set_state(LinkState::configuring, now_us, "device identified");
         send_configure(now_us);

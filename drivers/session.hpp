@@ -89,9 +89,10 @@ struct LinkStats {
   std::uint64_t timestamp_jumps = 0;  // device clock stepped backwards or far forwards
   std::uint64_t stuck_samples = 0;   // samples delivered while stuck
   std::uint64_t stuck_episodes = 0;  // times the sensor became stuck
+  std::uint64_t identity_rejected = 0;  // DEVICE_INFO of another kind or serial than the rig expects
   std::uint64_t samples_delivered = 0;
   std::uint64_t disconnects = 0;
-  std::uint64_t reconnects = 0;
+  std::uint64_t reconnects = 0;       // the device identified itself again after a loss
   std::uint64_t latency_count = 0;
   std::uint64_t latency_last_us = 0;
   std::uint64_t latency_max_us = 0;
@@ -138,6 +139,10 @@ struct SessionConfig {
   // own time is a frozen sensor: a real one always jitters. Samples whose timestamps do not advance
   // are repeats, not evidence. Pedals at rest legitimately repeat, so they are not checked.
   std::uint64_t stuck_after_us = 50'000;
+  // Identity the rig expects at this address (0: any). A device announcing another kind or serial
+  // is not configured: the wrong tracker plugged into the tracker's port must not drive the forceps.
+  std::uint8_t expected_device_type = 0;       // vp_device_type
+  std::uint32_t expected_serial = 0;
 };
 
 class DeviceSession {
@@ -197,6 +202,7 @@ class DeviceSession {
   vp_device_info info_{};
   bool have_info_ = false;
   bool configured_ = false;
+  bool recovering_ = false;  // the transport was re-opened after a loss; the device not identified yet
   ClockMapper clock_;
   std::uint64_t last_frame_us_ = 0, last_sample_us_ = 0, state_since_us_ = 0;
   std::uint64_t next_retry_us_ = 0, next_sync_us_ = 0, next_reconnect_us_ = 0;

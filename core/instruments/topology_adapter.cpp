@@ -54,8 +54,7 @@ void TopologyAdapter::cut(TissueWorld& /*world*/, const CuttingPose& pose) {
 void TopologyAdapter::remove(TissueWorld& /*world*/, const RemovalRequest& request) {
   for (auto& v : vitrectors_) {
     Status s = v->set_pose(request.port_center_mm, request.port_normal);
-    if (s) s = v->set_vacuum(0.0);  // attraction is the solver's SuctionField
-    if (s) s = v->set_cut_rate(std::min(request.cut_rate_hz * 60.0, v->settings().max_cut_rate_cpm));
+    if (s) s = v->set_cut_rate(std::min(request.cut_rate_cpm, v->settings().max_cut_rate_cpm));
     if (!s) {
       last_error_ = s;
       continue;

@@ -4,8 +4,8 @@
 // pose every step, so a cut made in thousands of 1 ms steps is the cut of the whole path; scissors
 // keep a Scissors per surface (both jaws' incisions, cutting as they close). An instrument leaving
 // the eye ends its incisions. The vitrector removes through Vitrector's guillotine; suction itself
-// is applied by the solver (SuctionField), so the adapter runs the topology vitrector with zero
-// attraction and only its cutter.
+// is applied by the solver (SuctionField); build the adapter with the instruments'
+// VitrectorSettings (InstrumentSceneOptions::vitrector) so both use one model.
 //
 // Room for kMaxInstruments instruments is made at construction (no allocation in the step); an
 // instrument index beyond it is refused with an error in last_error().

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -166,7 +167,9 @@ int main(int argc, char** argv) {
   std::string lcm_url;
   std::string replay_path;
   std::string pedal_config;
+  std::string rig_path;
   std::vector<std::string> serial_devices;
+  std::vector<std::string> sim_unplugs;
   bool realtime = false;
   bool verify_replay = true;
   bool render = true;
@@ -194,9 +197,17 @@ int main(int argc, char** argv) {
   app.add_option("--cache", cache_dir, "folder for settled case starts (default: OUT/case-cache)");
   auto* lcm_opt = app.add_option("--lcm-url", lcm_url,
                  "publish telemetry live on this LCM URL (e.g. udpm://239.255.76.67:7667?ttl=0) instead of to a log");
+  auto* rig_option = app.add_option("--rig", rig_path,
+                                    "the rig's devices from a rig file (rig/config/*.toml): each device's URI (serial:, can:, usb:,\n"
+                                    "sim:), identity and role, and the pedal mapping (default: simulated devices over ptys)")
+                         ->check(CLI::ExistingFile);
   auto* serial_opt = app.add_option("--serial", serial_devices,
-                 "a real device instead of the simulators: KIND=PATH with KIND tracker|pedals|eyeball (repeatable)");
-  app.add_option("--pedal-config", pedal_config, "TOML pedal mapping (see rig/config/default-rig.toml)")
+                 "a real serial device instead of the simulators: KIND=PATH with KIND tracker|pedals|eyeball (repeatable)")
+      ->excludes(rig_option);
+  app.add_option("--sim-unplug", sim_unplugs,
+                 "simulated devices: pull NAME's cable AT seconds into the session (physics time) and plug it back FOR\n"
+                 "seconds later: NAME:AT:FOR, e.g. tracker-0:1.5:0.5 (repeatable)");
+  app.add_option("--pedal-config", pedal_config, "TOML pedal mapping (see rig/config/default-rig.toml; overrides the rig file's)")
       ->check(CLI::ExistingFile);
   auto* replay_opt =
       app.add_option("--replay", replay_path,
@@ -218,7 +229,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(64, 4096));
   // A replay takes its cases, resolution and length from the recording: options that would choose
   // them are refused rather than silently ignored.
-  for (CLI::Option* o : {case_opt, cases_opt, start_opt, retina_opt, texture_opt, duration_opt, serial_opt, lcm_opt, realtime_opt,
+  for (CLI::Option* o : {case_opt, cases_opt, start_opt, retina_opt, texture_opt, duration_opt, serial_opt, rig_option, lcm_opt, realtime_opt,
                          stdin_opt, display_opt})
     replay_opt->excludes(o);
   try {
@@ -232,6 +243,13 @@ int main(int argc, char** argv) {
 
   vitreo::rig::ModelConfig model;
   try {
+    std::vector<vitreo::rig::DeviceSpec> devices;
+    if (!rig_path.empty()) {
+      vitreo::rig::RigFile rig = vitreo::rig::read_rig_file(rig_path);
+      devices = std::move(rig.devices);
+      if (rig.pedals) model.pedals = *rig.pedals;
+      spdlog::info("rig {}: {} device(s){}", rig_path, devices.size(), rig.name.empty() ? "" : " — " + rig.name);
+    }
     if (!pedal_config.empty()) {
       const auto file = vitreo::files::read_text_file(pedal_config);
       if (!file.text) throw std::runtime_error("--pedal-config: " + file.error);
@@ -298,32 +316,79 @@ int main(int argc, char** argv) {
     if (render) fs::create_directories(config.png_dir);
     for (const auto& d : displays) config.displays.push_back(parse_display(d));
     if (!config.displays.empty() && !render) throw std::runtime_error("--display needs rendering (drop --no-render)");
-    if (serial_devices.empty()) {
-      const std::string base = "/tmp/vitreo-" + std::to_string(::getpid());
-      config.devices = {{"tracker-0", base + "-tracker", 1, 0, ""},
-                        {"pedals", base + "-pedals", 2, 0, kPedalScript},
-                        {"eyeball", base + "-eyeball", 3, 0, kEyeballScript}};
-      // The tracker's script follows the first case's anatomy (known once it is loaded).
-      config.adapt_devices = [](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& devices) {
-        devices[0].sim_script = tool_script(c);
-      };
-    } else {
+    using vitreo::rig::DeviceRole;
+    if (!serial_devices.empty()) {
       int id = 1;
       for (const auto& spec : serial_devices) {
         const auto eq = spec.find('=');
         if (eq == std::string::npos) throw std::runtime_error("--serial expects KIND=PATH, got '" + spec + "'");
         const std::string kind = spec.substr(0, eq), path = spec.substr(eq + 1);
-        if (kind != "tracker" && kind != "pedals" && kind != "eyeball")
-          throw std::runtime_error("--serial " + spec + ": unknown device kind '" + kind + "' (tracker, pedals, eyeball)");
-        for (const auto& d : config.devices) {
-          if (d.name == kind) throw std::runtime_error("--serial " + spec + ": a second " + kind + " (one of each)");
-          if (d.serial_path == path) throw std::runtime_error("--serial " + spec + ": " + path + " is already the " + d.name);
+        vitreo::rig::DeviceSpec d;
+        d.name = kind;
+        if (kind == "tracker") d.role = DeviceRole::tracker;
+        else if (kind == "pedals") d.role = DeviceRole::pedals;
+        else if (kind == "eyeball") d.role = DeviceRole::eyeball;
+        else throw std::runtime_error("--serial " + spec + ": unknown device kind '" + kind + "' (tracker, pedals, eyeball)");
+        for (const auto& other : devices) {
+          if (other.name == kind) throw std::runtime_error("--serial " + spec + ": a second " + kind + " (one of each)");
+          if (other.uri == "serial:" + path) throw std::runtime_error("--serial " + spec + ": " + path + " is already the " + other.name);
         }
         if (const std::string why = vitreo::app::serial_port_problem(path); !why.empty())
           throw std::runtime_error("--serial " + spec + ": " + why);
-        config.devices.push_back({kind, path, id++, 0, ""});
+        d.uri = "serial:" + path;
+        d.device_id = id++;
+        devices.push_back(d);
       }
+    } else if (devices.empty()) {
+      // The embedded default: the three devices simulated behind ptys.
+      devices = {{"tracker-0", DeviceRole::tracker, "sim:tracker?transport=pty", 1, 0, 0, 0, ""},
+                 {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, ""},
+                 {"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, 0, ""}};
     }
+    config.devices = devices;
+    struct Unplug {
+      std::string name;
+      std::uint64_t at_step, back_step;
+    };
+    std::vector<Unplug> unplugs;
+    for (const auto& u : sim_unplugs) {
+      const auto a = u.find(':'), b = u.rfind(':');
+      char* end = nullptr;
+      const double at = a == std::string::npos || a == b ? -1.0 : std::strtod(u.c_str() + a + 1, &end);
+      const double len = at < 0.0 ? -1.0 : std::strtod(u.c_str() + b + 1, &end);
+      const std::string name = u.substr(0, a);
+      if (!(at >= 0.0) || !(len > 0.0) || *end != '\0') throw std::runtime_error("--sim-unplug " + u + ": expected NAME:AT:FOR (seconds)");
+      const auto named = std::find_if(devices.begin(), devices.end(), [&](const auto& d) { return d.name == name; });
+      if (named == devices.end()) throw std::runtime_error("--sim-unplug " + u + ": no device named " + name);
+      if (named->uri.rfind("sim:", 0) != 0) throw std::runtime_error("--sim-unplug " + u + ": " + name + " is not simulated");
+      unplugs.push_back({name, static_cast<std::uint64_t>(std::llround(at / model.dt_s)),
+                         static_cast<std::uint64_t>(std::llround((at + len) / model.dt_s))});
+    }
+    if (!unplugs.empty()) {
+      config.on_step = [unplugs](std::uint64_t step, vitreo::rig::DeviceHub& hub) {
+        for (const auto& u : unplugs) {
+          if (step != u.at_step && step != u.back_step) continue;
+          for (std::size_t i = 0; i < hub.device_count(); ++i) {
+            if (hub.name(i) != u.name) continue;
+            step == u.at_step ? hub.unplug(i) : hub.plug(i);
+          }
+        }
+      };
+    }
+    // Simulated devices without a script of their own play the main job's scripted session; the
+    // tool tracker's script follows the first case's anatomy (known once it is loaded).
+    config.adapt_devices = [](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& specs) {
+      for (auto& d : specs) {
+        if (d.uri.rfind("sim:", 0) != 0 || !d.sim_script.empty()) continue;
+        switch (d.role) {
+          case DeviceRole::tracker:
+            if (d.channel == vitreo::rig::kToolTracker) d.sim_script = tool_script(c);
+            break;
+          case DeviceRole::pedals: d.sim_script = kPedalScript; break;
+          case DeviceRole::eyeball: d.sim_script = kEyeballScript; break;
+        }
+      }
+    };
 
     static std::atomic<int> stop_signal{0};
     vitreo::app::install_stop_signals(stop_signal);

@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <variant>
 
+#include <unistd.h>
+
+#include "drivers/open_device.hpp"
+#include "drivers/sim/simulated_peer.hpp"
 #include "rig/session/device_inputs.hpp"
 #include "rig/session/simulation_model.hpp"
 
@@ -16,15 +20,18 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
   for (auto& spec : specs) {
     auto d = std::make_unique<Device>();
     d->spec = spec;
-    if (!spec.sim_script.empty()) {
-      drivers::sim::Script script;
-      std::string error;
-      if (!drivers::sim::parse_script(spec.sim_script, script, &error)) {
-        throw std::runtime_error("device " + spec.name + ": bad simulation script: " + error);
-      }
-      d->sim = std::make_unique<drivers::sim::PtySimDevice>(script, spec.serial_path);
-    }
-    d->driver = std::make_unique<drivers::SerialDevice>(spec.serial_path, clock_);
+    drivers::OpenOptions options;
+    // the device at this address must be the kind its role says (and the serial, when given)
+    options.session.expected_device_type = spec.role == DeviceRole::tracker  ? VP_DEVICE_TRACKER
+                                           : spec.role == DeviceRole::pedals ? VP_DEVICE_PEDAL
+                                                                             : VP_DEVICE_EYEBALL;
+    options.session.expected_serial = spec.expected_serial;
+    if (spec.sample_rate_hz > 0) options.session.sample_rate_hz = spec.sample_rate_hz;
+    options.sim_script = spec.sim_script;
+    options.sim_link = "/tmp/vitreo-" + std::to_string(::getpid()) + "-" + spec.name;
+    std::string error;
+    d->driver = drivers::open_device(spec.uri, clock_, options, &error);
+    if (!d->driver) throw std::runtime_error("device " + spec.name + ": " + error);
     Device* raw = d.get();
     // A link change as a recorded input: values[0] the LinkInput, values[1] the device's type (from
     // its DEVICE_INFO, 0 before one came) — only a tracker's link freezes an instrument.
@@ -87,15 +94,16 @@ void DeviceHub::plug(std::size_t device) { devices_.at(device)->plug_request.sto
 
 void DeviceHub::run_sims() {
   // The emulators stand in for the devices' own firmware: they run on their own thread, in real
-  // time, and the drivers know nothing about them beyond the bytes on the pty.
+  // time, and the drivers know nothing about them beyond the bytes on their transport.
   while (running_.load(std::memory_order_acquire)) {
     const std::uint64_t now = clock_.now_us();
     for (auto& d : devices_) {
-      if (!d->sim) continue;
+      drivers::sim::SimulatedPeer* peer = d->driver->simulated_peer();
+      if (!peer) continue;
       const int request = d->plug_request.exchange(0);
-      if (request < 0) d->sim->unplug();
-      if (request > 0) d->sim->plug();
-      d->sim->step(now);
+      if (request < 0) peer->unplug();
+      if (request > 0) peer->plug();
+      peer->step(now);
     }
     std::this_thread::sleep_for(std::chrono::microseconds(250));
   }
@@ -151,7 +159,7 @@ void DeviceHub::publish_status(std::uint64_t) {
     telemetry::DeviceStatus s;
     s.device_id = d->spec.device_id;
     std::strncpy(s.name, d->spec.name.c_str(), sizeof s.name - 1);
-    std::strncpy(s.transport, ("serial:" + d->spec.serial_path).c_str(), sizeof s.transport - 1);
+    std::strncpy(s.transport, d->driver->uri().c_str(), sizeof s.transport - 1);
     s.state = status_code(session.state());
     std::strncpy(s.detail, drivers::to_string(session.state()), sizeof s.detail - 1);
     s.frames_rx = static_cast<std::int64_t>(st.frames);

@@ -194,7 +194,7 @@ bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSn
     }
   }
   // Instruments as the simulation placed them (eye frame, after the eye's rotation).
-  const core::InstrumentSystem& sys = model.instrument_system();
+  const core::Simulation& sys = model.simulation();
   constexpr std::uint32_t kSlots = sizeof(out.instruments) / sizeof(out.instruments[0]);
   for (std::uint32_t i = 0; i < kSlots; ++i) {
     auto& o = out.instruments[i];
@@ -230,6 +230,22 @@ bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSn
     for (int k = 0; k < 3; ++k) o.position_mm[k] = static_cast<float>(p[k]);
     o.diameter_mm = static_cast<float>(b.diameter_mm);
     o.surface = b.surface;
+    const core::Surface& s = world.surface(b.surface);
+    // Surface coordinates while the burnt triangle still exists (a cut replaces it) and its corners are
+    // in the snapshot's vertex range; otherwise only the position goes to the renderer.
+    o.on_triangle = false;
+    if (b.surface < out.surfaces.size() && s.triangle_alive(b.triangle.index) && s.triangle_id(b.triangle.index) == b.triangle) {
+      const auto corners = s.triangle_vertices(b.triangle.index);
+      const std::size_t n = out.surfaces[b.surface].xyz.size() / 3;
+      o.on_triangle = corners[0] < n && corners[1] < n && corners[2] < n;
+    }
+    if (o.on_triangle) {
+      const auto corners = s.triangle_vertices(b.triangle.index);
+      for (int k = 0; k < 3; ++k) {
+        o.corners[k] = corners[static_cast<std::size_t>(k)];
+        o.barycentric[k] = static_cast<float>(b.bary[k]);
+      }
+    }
   }
   return true;
 }
@@ -286,7 +302,13 @@ render::FrameScene FrameBuilder::build(const ViewSnapshot& snap) {
     for (std::uint32_t b = 0; b < snap.n_burns; ++b) {
       if (snap.burns[b].surface != i) continue;
       render::LaserBurn burn;
-      burn.hit_position_mm = render::Vec3{snap.burns[b].position_mm[0], snap.burns[b].position_mm[1], snap.burns[b].position_mm[2]};
+      const BurnSnapshot& spot = snap.burns[b];
+      if (spot.on_triangle) {
+        burn.hit_point = render::LaserBurn::SurfacePoint{{spot.corners[0], spot.corners[1], spot.corners[2]},
+                                                         {spot.barycentric[0], spot.barycentric[1], spot.barycentric[2]}};
+      } else {
+        burn.hit_position_mm = render::Vec3{spot.position_mm[0], spot.position_mm[1], spot.position_mm[2]};
+      }
       burn.radius_mm = 0.5f * snap.burns[b].diameter_mm;
       mesh.burns.push_back(burn);
     }

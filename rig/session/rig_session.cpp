@@ -297,7 +297,7 @@ SessionSummary run_session(const SessionConfig& config) {
     for (const auto& e : model.world().events()) {
       if (e.kind != core::TissueEventKind::kRolledBack) physics_out.push(to_event(e, step, t_s));
     }
-    for (const auto& e : model.instrument_system().events()) {
+    for (const auto& e : model.simulation().events()) {
       physics_out.push(instrument_event(e, step, t_s));
       ++summary.instrument_events;
       if (e.kind == core::InstrumentEventKind::kGrasp) ++summary.grasps;

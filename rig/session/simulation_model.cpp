@@ -120,7 +120,7 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
 core::StepReport SimulationModel::step() {
   if (paused_) return {};
   const SurgicalControls& c = pedals_.controls();
-  core::InstrumentSystem& sys = *case_->system;
+  core::Simulation& sys = *case_->sim;
   const int tool = selected_tool();
   const double vacuum = pedals_.mapping().vacuum_max_mmhg > 0.0 ? c.vacuum_mmhg / pedals_.mapping().vacuum_max_mmhg : 0.0;
   auto tracked = [&](const InstrumentSlot& slot) {
@@ -157,10 +157,8 @@ core::StepReport SimulationModel::step() {
   sys.set_air_infusion(c.air_infusion);
   sys.set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
-  const core::StepReport report = sys.step(config_.dt_s).tissue;
-  // Metrics observe every step here, in the model, so a replay measures the same session exactly.
-  (void)case_->metrics->observe(config_.dt_s);
-  return report;
+  // The case's metrics observe the step as its last stage, so a replay measures the same session.
+  return sys.step(config_.dt_s).tissue;
 }
 
 std::uint64_t SimulationModel::state_hash() const {

@@ -12,7 +12,7 @@
 
 #include <string>
 
-#include "core/instruments/instrument_system.hpp"
+#include "core/sim/simulation.hpp"
 #include "rig/input/controls.hpp"
 #include "rig/input/port_pivot.hpp"
 #include "rig/scene_io/case_loader.hpp"
@@ -80,7 +80,8 @@ class SimulationModel {
   void stage(std::unique_ptr<PreparedCase> prepared) { staged_ = std::move(prepared); }
   bool has_staged() const { return staged_ != nullptr; }
   std::unique_ptr<PreparedCase> take_retired() { return std::move(retired_); }
-  // One physics step (skipped while paused). Returns the core's report.
+  // Maps the inputs onto the case's instruments and runs one core::Simulation step, metrics
+  // included (skipped while paused). Returns the tissue's report.
   core::StepReport step();
   bool paused() const { return paused_; }
   // View state the operator sets (wireframe and labels toggles, microscope zoom override).
@@ -90,7 +91,7 @@ class SimulationModel {
   std::uint64_t resets() const { return resets_; }
 
   core::TissueWorld& world() { return case_->scene->world; }
-  const core::InstrumentSystem& instrument_system() const { return *case_->system; }
+  const core::Simulation& simulation() const { return *case_->sim; }
   const core::TissueWorld& world() const { return case_->scene->world; }
   const core::Scene& scene() const { return *case_->scene; }
   const PreparedCase& current_case() const { return *case_; }

@@ -20,7 +20,13 @@ struct SurfaceSnapshot {
 };
 
 struct BurnSnapshot {
-  float position_mm[3] = {};  // where the spot is now (it moves with the tissue)
+  // Surface coordinates of the spot: the triangle it was burnt on (its corner vertices) and the
+  // barycentric point in it — it moves with the tissue. on_triangle false: the triangle was cut
+  // since, and only the position is known.
+  bool on_triangle = false;
+  std::uint32_t corners[3] = {};
+  float barycentric[3] = {1, 0, 0};
+  float position_mm[3] = {};  // where the spot is now
   float diameter_mm = 0.0f;
   std::uint32_t surface = 0;
 };

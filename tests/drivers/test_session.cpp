@@ -76,7 +76,10 @@ TEST(Session, HandshakeStaleLostSequence) {
   EXPECT_EQ(h.s.state(), LinkState::reconnecting);
   h.s.transport_up(400'100);
   EXPECT_EQ(h.s.state(), LinkState::connecting);
-  EXPECT_EQ(h.s.stats().reconnects, 1u);
+  EXPECT_EQ(h.s.stats().reconnects, 0u) << "re-opening the transport is not finding the device";
+  h.info(400'200);
+  EXPECT_EQ(h.s.state(), LinkState::configuring);
+  EXPECT_EQ(h.s.stats().reconnects, 1u) << "the device identified itself again";
 }
 
 // Stuck = bit-identical poses for >= 50 ms of the device's own time (issue 20): not a number of

@@ -27,7 +27,7 @@ RenderThread::RenderThread(RenderThreadOptions options) : options_(std::move(opt
 RenderThread::~RenderThread() { stop(); }
 
 void RenderThread::publish(FrameScene scene) {
-  mailbox_.publish(std::move(scene));
+  mailbox_.write(std::move(scene));
   // Wakes the render thread if it sleeps on wake_; a notify is a syscall at most, never a wait.
   wake_.fetch_add(1, std::memory_order_release);
   wake_.notify_one();

@@ -440,12 +440,35 @@ struct StereoRenderer::Impl {
     const Mat4 inv_model = rigid_inverse(mesh.model);
     for (std::size_t b = g.burns_painted; b < mesh.burns.size(); ++b) {
       const LaserBurn& burn = mesh.burns[b];
-      // Find the triangle under the hit, its uv there and the surface metric JᵀJ (mm² per uv²).
+      // The triangle under the hit, its uv there and the surface metric JᵀJ (mm² per uv²).
       Vec2 uv{};
       float g00 = 0, g01 = 0, g11 = 0;
       bool found = false;
       const std::size_t tris = geo.indices.size() / 3;
-      if (burn.hit_position_mm) {
+      const auto on_triangle = [&](const Vertex& va, const Vertex& vb, const Vertex& vc, const std::array<float, 3>& bc) {
+        uv = {va.uv.x * bc[0] + vb.uv.x * bc[1] + vc.uv.x * bc[2], va.uv.y * bc[0] + vb.uv.y * bc[1] + vc.uv.y * bc[2]};
+        // J = E · T⁻¹ with E = [b−a, c−a] (3×2) and T = [uv_b−uv_a, uv_c−uv_a] (2×2).
+        const Vec3 e1 = vb.position_mm - va.position_mm, e2 = vc.position_mm - va.position_mm;
+        const float t00 = vb.uv.x - va.uv.x, t10 = vb.uv.y - va.uv.y;
+        const float t01 = vc.uv.x - va.uv.x, t11 = vc.uv.y - va.uv.y;
+        const float det = t00 * t11 - t01 * t10;
+        if (std::fabs(det) <= 1e-12f) return;
+        const float i00 = t11 / det, i01 = -t01 / det, i10 = -t10 / det, i11 = t00 / det;
+        const Vec3 j0 = e1 * i00 + e2 * i10;  // d position / du
+        const Vec3 j1 = e1 * i01 + e2 * i11;  // d position / dv
+        g00 = dot(j0, j0);
+        g01 = dot(j0, j1);
+        g11 = dot(j1, j1);
+        found = true;
+      };
+      if (burn.hit_point) {
+        // Surface coordinates from the simulation: the triangle and the point in it, no search.
+        const auto& c = burn.hit_point->corners;
+        if (c[0] < geo.vertices.size() && c[1] < geo.vertices.size() && c[2] < geo.vertices.size()) {
+          on_triangle(geo.vertices[c[0]], geo.vertices[c[1]], geo.vertices[c[2]], burn.hit_point->barycentric);
+        }
+      } else if (burn.hit_position_mm) {
+        // Only a point: the nearest triangle of the current surface.
         const Vec3 p = inv_model.transform_point(*burn.hit_position_mm);
         float best = std::numeric_limits<float>::max();
         std::size_t best_t = 0;
@@ -460,25 +483,8 @@ struct StereoRenderer::Impl {
           if (d < best) { best = d; best_t = t; best_bc = bc; }
         }
         if (tris > 0 && best <= 0.25f) {
-          const Vertex& va = geo.vertices[geo.indices[3 * best_t]];
-          const Vertex& vb = geo.vertices[geo.indices[3 * best_t + 1]];
-          const Vertex& vc = geo.vertices[geo.indices[3 * best_t + 2]];
-          uv = {va.uv.x * best_bc[0] + vb.uv.x * best_bc[1] + vc.uv.x * best_bc[2],
-                va.uv.y * best_bc[0] + vb.uv.y * best_bc[1] + vc.uv.y * best_bc[2]};
-          // J = E · T⁻¹ with E = [b−a, c−a] (3×2) and T = [uv_b−uv_a, uv_c−uv_a] (2×2).
-          const Vec3 e1 = vb.position_mm - va.position_mm, e2 = vc.position_mm - va.position_mm;
-          const float t00 = vb.uv.x - va.uv.x, t10 = vb.uv.y - va.uv.y;
-          const float t01 = vc.uv.x - va.uv.x, t11 = vc.uv.y - va.uv.y;
-          const float det = t00 * t11 - t01 * t10;
-          if (std::fabs(det) > 1e-12f) {
-            const float i00 = t11 / det, i01 = -t01 / det, i10 = -t10 / det, i11 = t00 / det;
-            const Vec3 j0 = e1 * i00 + e2 * i10;  // d position / du
-            const Vec3 j1 = e1 * i01 + e2 * i11;  // d position / dv
-            g00 = dot(j0, j0);
-            g01 = dot(j0, j1);
-            g11 = dot(j1, j1);
-            found = true;
-          }
+          on_triangle(geo.vertices[geo.indices[3 * best_t]], geo.vertices[geo.indices[3 * best_t + 1]],
+                      geo.vertices[geo.indices[3 * best_t + 2]], best_bc);
         }
       } else if (burn.hit_uv) {
         uv = *burn.hit_uv;

@@ -1,6 +1,9 @@
 // Eye model dimensions, fundus textures, scene building (tears, membranes, gel) and snapshots.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
+
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -203,6 +206,50 @@ TEST(Snapshot, CorruptOrForeignSnapshotsAreRefusedWithoutChange) {
   Scene o = build_scene(other, {false, false});
   EXPECT_FALSE(decode_snapshot(o.world, bytes).is_ok());
   EXPECT_FALSE(load_snapshot(a.world, "/nonexistent/x.snap").is_ok());
+}
+
+// The state's field lists read what they wrote, and validate what they read before anything is
+// applied: a material, solver settings or an attachment that would be invalid in the world refuses
+// the whole state, and the world is unchanged. (The state is written and read directly here, without
+// the snapshot header, so the bytes can be edited without a checksum in the way.)
+TEST(StateIo, ValuesAreValidatedBeforeAnythingIsApplied) {
+  Scene a = build_scene(busy_scene(), {false, false});
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(a.world.step(1e-3).ok);
+  std::vector<std::uint8_t> bytes;
+  a.world.write_state(bytes);
+  Scene b = build_scene(busy_scene(), {false, false});
+  const auto fresh = b.world.state_hash();
+  // a double field of the state, located by its value
+  auto patched = [&](double was, double now) {
+    std::vector<std::uint8_t> out = bytes;
+    std::uint8_t pattern[8];
+    std::memcpy(pattern, &was, 8);
+    const auto at = std::search(out.begin(), out.end(), pattern, pattern + 8);
+    EXPECT_NE(at, out.end()) << "value " << was << " not in the state";
+    if (at != out.end()) std::memcpy(&*at, &now, 8);
+    return out;
+  };
+  const double density = a.world.surface(0).material().density_g_per_mm3;
+  const Status bad_material = b.world.read_state(patched(density, -1.0).data(), bytes.size());
+  EXPECT_FALSE(bad_material.is_ok());
+  EXPECT_NE(bad_material.message().find("density"), std::string::npos) << bad_material.message();
+  EXPECT_EQ(b.world.state_hash(), fresh) << "nothing applied";
+  const Status bad_settings = b.world.read_state(patched(a.world.settings().wall_friction, -3.0).data(), bytes.size());
+  EXPECT_FALSE(bad_settings.is_ok());
+  EXPECT_EQ(b.world.state_hash(), fresh);
+  const Status trailing = [&] {
+    auto longer = bytes;
+    longer.push_back(0);
+    return b.world.read_state(longer.data(), longer.size());
+  }();
+  EXPECT_NE(trailing.message().find("trailing bytes"), std::string::npos) << trailing.message();
+  EXPECT_EQ(b.world.state_hash(), fresh);
+  // the unedited state reads back into the same state, and writes the same bytes
+  ASSERT_TRUE(b.world.read_state(bytes.data(), bytes.size()).is_ok());
+  EXPECT_EQ(b.world.state_hash(), a.world.state_hash());
+  std::vector<std::uint8_t> again;
+  b.world.write_state(again);
+  EXPECT_EQ(again, bytes);
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ CutResult radial_stroke(Cutter& cutter, const Vec3& from, const Vec3& to) {
   return cutter.sweep({from * 0.9, from * 1.06}, {to * 0.9, to * 1.06});
 }
 
-// Operation i of a fixed sequence: blade strokes along meridians, vitrector suction with removal,
+// Operation i of a fixed sequence: blade strokes along meridians, the vitrector (its field and removal),
 // and torn springs, at places that move around the retina.
 void operate(RetinaCapScene& scene, Cutter& cutter, Vitrector& vitrector, int i) {
   Surface& s = scene.world.surface(scene.retina);
@@ -71,10 +71,7 @@ TEST(SpringGroups, FollowCutsSuctionAndTearsExactlyWithoutRebuilding) {
   RetinaCapScene followed = small_retina(), rebuilt = small_retina();
   Cutter cut_f(followed.world.surface(followed.retina)), cut_r(rebuilt.world.surface(rebuilt.retina));
   Vitrector vit_f(followed.world.surface(followed.retina)), vit_r(rebuilt.world.surface(rebuilt.retina));
-  for (Vitrector* v : {&vit_f, &vit_r}) {
-    ASSERT_TRUE(v->set_vacuum(400.0));
-    ASSERT_TRUE(v->set_cut_rate(5000.0));
-  }
+  for (Vitrector* v : {&vit_f, &vit_r}) ASSERT_TRUE(v->set_cut_rate(5000.0));
   ASSERT_TRUE(followed.world.step(1e-3).ok);
   ASSERT_TRUE(rebuilt.world.step(1e-3).ok);
   const std::uint64_t rebuilds0 = followed.world.spring_group_rebuilds();

@@ -330,14 +330,30 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   model.step();
   ASSERT_TRUE(model.apply(pedal(0)));
   model.step();
-  ASSERT_EQ(model.instrument_system().burns().size(), 1u) << "one pulse on the rising edge";
-  const core::Vec3 hit = model.instrument_system().burn_position(model.instrument_system().burns()[0]);
+  ASSERT_EQ(model.simulation().burns().size(), 1u) << "one pulse on the rising edge";
+  const core::Vec3 hit = model.simulation().burn_position(model.simulation().burns()[0]);
   rig::ViewSnapshot view;
   ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
   ASSERT_EQ(view.n_burns, 1u);
+  // Handed over as surface coordinates: the burnt triangle's corners and the point in it, which lies
+  // where the simulation says the spot is now.
+  const rig::BurnSnapshot& spot = view.burns[0];
+  ASSERT_TRUE(spot.on_triangle);
+  const rig::SurfaceSnapshot& surf = view.surfaces[spot.surface];
+  core::Vec3 at = core::Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    for (int axis = 0; axis < 3; ++axis) at[axis] += spot.barycentric[k] * surf.xyz[3 * spot.corners[k] + static_cast<std::uint32_t>(axis)];
+  }
+  EXPECT_LT((at - hit).norm(), 1e-4);
   const vr::FrameScene after = builder.build(view);
   std::size_t burns = 0;
-  for (const auto& m : after.meshes) burns += m.burns.size();
+  for (const auto& m : after.meshes) {
+    burns += m.burns.size();
+    for (const auto& b : m.burns) {
+      EXPECT_TRUE(b.hit_point.has_value()) << "the renderer gets the triangle, not a point to search for";
+      EXPECT_FALSE(b.hit_position_mm.has_value());
+    }
+  }
   EXPECT_EQ(burns, 1u);
   vr::FrameScene cleared = after;
   for (auto& m : cleared.meshes) m.burns.clear();
@@ -382,9 +398,9 @@ TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
   ASSERT_TRUE(model.apply(pedal(1.0, 0)));       // full aspiration
   ASSERT_TRUE(model.controls().air_infusion);
   model.step();
-  const double top = model.instrument_system().fluid_level_z_mm();
+  const double top = model.simulation().fluid_level_z_mm();
   for (int i = 0; i < 400; ++i) model.step();
-  const double level = model.instrument_system().fluid_level_z_mm();
+  const double level = model.simulation().fluid_level_z_mm();
   std::printf("fluid level: %.2f mm at the start of the exchange, %.2f mm after 0.4 s of aspiration\n", top, level);
   EXPECT_NEAR(top - level, 0.4 * 2.0, 0.1) << "falls at the aspiration rate (2 mm/s at full vacuum)";
   rig::ViewSnapshot v1;

@@ -76,7 +76,8 @@ rig::SessionConfig small_session(const std::string& tag, std::uint64_t steps) {
   c.steps = steps;
   c.lcm_url = "file://" + temp_path(tag + "-telemetry.lcmlog") + "?mode=w";
   c.record_path = temp_path(tag + "-session.lcmlog");
-  c.devices = {{"tracker-0", temp_path(tag + "-tracker"), 1, 0, kTracker}, {"pedals", temp_path(tag + "-pedals"), 2, 0, kPedals}};
+  c.devices = {{"tracker-0", rig::DeviceRole::tracker, "sim:tracker?transport=pty&link=" + temp_path(tag + "-tracker"), 1, 0, 0, 0, kTracker},
+               {"pedals", rig::DeviceRole::pedals, "sim:pedals?transport=pty&link=" + temp_path(tag + "-pedals"), 2, 0, 0, 0, kPedals}};
   return c;
 }
 
@@ -443,7 +444,7 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   EXPECT_EQ(c.tools[0], core::InstrumentKind::kForceps);
   EXPECT_EQ(c.tools[3], core::InstrumentKind::kVitrector);
   EXPECT_EQ(c.light_pipe, 4);
-  EXPECT_EQ(model.instrument_system().instrument_count(), 5u);
+  EXPECT_EQ(model.simulation().instrument_count(), 5u);
   // The tool pivots in the eye model's working_1 sclerotomy: between its outer and inner openings.
   const core::SclerotomyPort* w1 = nullptr;
   for (const auto& p : scene.eye.ports) {
@@ -466,11 +467,11 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   in.values[10] = 3.0;  // tool type
   ASSERT_TRUE(model.apply(in));
   model.step();
-  EXPECT_TRUE(model.instrument_system().instrument(0).input.present);
-  EXPECT_TRUE(model.instrument_system().instrument(0).inside);
-  EXPECT_FALSE(model.instrument_system().instrument(1).input.present);
+  EXPECT_TRUE(model.simulation().instrument(0).input.present);
+  EXPECT_TRUE(model.simulation().instrument(0).inside);
+  EXPECT_FALSE(model.simulation().instrument(1).input.present);
   // Where the tracker put it (the eye turns only slightly under the port's push).
-  EXPECT_LT((model.instrument_system().instrument(0).frame.tip - tip).norm(), 0.5);
+  EXPECT_LT((model.simulation().instrument(0).frame.tip - tip).norm(), 0.5);
 }
 
 TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {

@@ -10,6 +10,7 @@
 // anterior (toward the microscope). The patient is supine and the surgeon looks down −z through the
 // microscope, so "deeper into the eye" is "downward" for the surgeon — the orientation the thesis'
 // surgeons asked for after complaining the prototype's axes were reversed.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -55,12 +56,19 @@ using MeshGeometryPtr = std::shared_ptr<const MeshGeometry>;
 
 /// A laser burn on one mesh, painted once into that mesh's burn texture (in its uv space, so the
 /// burn moves with the tissue and sits exactly where the ray hit, not at the nearest vertex — the
-/// thesis' "geometry dependence" complaint). Give the hit either as a surface point (the renderer
-/// finds the triangle and its barycentric uv) or directly as uv.
+/// thesis' "geometry dependence" complaint). Give the hit as surface coordinates (the triangle, by
+/// its three vertex indices into the mesh, and the barycentric point in it: what the simulation
+/// knows, so nothing is searched), or as a point on the current surface (the renderer finds the
+/// nearest triangle), or directly as uv.
 struct LaserBurn {
-  std::optional<Vec3> hit_position_mm;  // on the mesh's *current* surface
-  std::optional<Vec2> hit_uv;           // used when hit_position_mm is empty
+  struct SurfacePoint {
+    std::array<std::uint32_t, 3> corners{};   // vertex indices of the hit triangle
+    std::array<float, 3> barycentric{1, 0, 0};
+  };
+  std::optional<Vec3> hit_position_mm;  // on the mesh's *current* surface; used without hit_point
+  std::optional<Vec2> hit_uv;           // used without either
   float radius_mm = 0.25f;              // soft edge from 0.6·radius out to radius
+  std::optional<SurfacePoint> hit_point;  // preferred when given
 };
 
 struct Mesh {

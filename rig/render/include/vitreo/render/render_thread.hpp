@@ -1,7 +1,7 @@
 #pragma once
 // RenderThread: renders the latest FrameScene on its own thread, with its own EGL context.
 //
-// The physics side only calls publish(), which is wait-free (LatestSlot): rendering can never slow
+// The physics side only calls publish(), which is wait-free (runtime::TripleBuffer): rendering can never slow
 // the simulation down; if rendering is slower than physics, intermediate scenes are skipped (and
 // counted). Each rendered frame carries the sim time and step index of the scene it shows and is
 // handed to the sinks: the shared-memory ring (if named), PNG files on request, and a callback.
@@ -19,7 +19,7 @@
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/frame_scene.hpp"
 #include "vitreo/render/kms_display.hpp"
-#include "vitreo/render/latest_slot.hpp"
+#include "rig/runtime/triple_buffer.hpp"
 #include "vitreo/render/renderer.hpp"
 
 namespace vitreo::render {
@@ -77,7 +77,7 @@ class RenderThread {
   void run(std::promise<void>& started);
   void present_on_displays(const StereoFrame& frame, std::vector<std::unique_ptr<KmsDisplay>>& displays);
   RenderThreadOptions options_;
-  LatestSlot<FrameScene> mailbox_;
+  runtime::TripleBuffer<FrameScene> mailbox_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> wake_{0};  // bumped by publish()/stop(); the render thread sleeps on it
   std::atomic<std::uint64_t> frames_{0};
