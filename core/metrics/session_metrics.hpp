@@ -71,6 +71,9 @@ class SessionMetrics {
   bool complete();
   // Criteria, then the scores (no allocation).
   const ScoreCard& score();
+  // What the last score() / criteria() found, without measuring again (the picture shows these).
+  const ScoreCard& last_score() const { return card_; }
+  const CaseProgress& progress() const { return progress_; }
 
  private:
   const TissueWorld& world_;

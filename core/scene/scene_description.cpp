@@ -52,7 +52,7 @@ const char* to_string(CriterionKind k) {
 
 const char* to_string(GelStain s) {
   switch (s) {
-    case GelStain::kNone: return "none";
+    case GelStain::kClear: return "none";
     case GelStain::kTriamcinolone: return "triamcinolone";
   }
   return "?";
@@ -209,7 +209,7 @@ void SceneDescription::validate() const {
     location("view: region_of_interest", *view.region_of_interest);
     require_range(view.region_of_interest->polar_deg, 0.0, 90.0, "view: region_of_interest: polar_deg");
   }
-  if (view.gel_stain != GelStain::kNone && anatomy.gel_shells == 0) {
+  if (view.gel_stain != GelStain::kClear && anatomy.gel_shells == 0) {
     throw InvalidArgument("view: gel_stain needs gel (anatomy.gel_shells > 0)");
   }
   if (settle.max_steps < 0 || settle.max_steps > 20000) throw InvalidArgument("settle: max_steps must be in [0, 20000]");

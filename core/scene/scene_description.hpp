@@ -95,14 +95,14 @@ struct CriterionSpec {
 
 // How the case is seen (not physics): where the microscope starts, what the gel looks like, the
 // lighting. Read by the rig's microscope and renderer only; a change here never moves tissue.
-enum class GelStain : std::uint8_t { kNone, kTriamcinolone };
+enum class GelStain : std::uint8_t { kClear, kTriamcinolone };
 struct ViewSpec {
   // Where the microscope's field starts; unset: the pathology the case is about (its first tear,
   // membrane, detachment or guide), else the fovea.
   std::optional<FundusLocation> region_of_interest;
   // The vitreous as the surgeon sees it: clear (a faint haze) or stained white with triamcinolone
   // crystals, as surgeons do to see the gel they are removing. Needs gel (anatomy.gel_shells > 0).
-  GelStain gel_stain = GelStain::kNone;
+  GelStain gel_stain = GelStain::kClear;
   bool wide_angle = false;  // the case starts with the wide-angle viewing system swung in
   bool chandelier = false;  // a chandelier fibre in the superior pars plana lights the cavity
 };

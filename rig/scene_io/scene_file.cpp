@@ -492,7 +492,7 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     if (t->has("region_of_interest")) d.view.region_of_interest = t->location("region_of_interest");
     std::string stain = core::to_string(d.view.gel_stain);
     t->string("gel_stain", stain);
-    if (stain == "none") d.view.gel_stain = core::GelStain::kNone;
+    if (stain == "none") d.view.gel_stain = core::GelStain::kClear;
     else if (stain == "triamcinolone") d.view.gel_stain = core::GelStain::kTriamcinolone;
     else t->fail("gel_stain", "must be \"none\" or \"triamcinolone\"");
     t->boolean("wide_angle", d.view.wide_angle);

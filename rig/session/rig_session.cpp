@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <algorithm>
 #include <array>
@@ -107,6 +108,10 @@ telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
   in.n_values = 2;
   in.values[0] = static_cast<double>(static_cast<int>(cmd.code));
   in.values[1] = cmd.value;
+  if (cmd.code == telemetry::CommandCode::Pan) {  // y travels as text (validated by the server)
+    in.n_values = 3;
+    in.values[2] = std::strtod(cmd.arg, nullptr);
+  }
   return in;
 }
 

@@ -146,7 +146,7 @@ TEST(CaseLoader, SecondLoadComesFromTheCacheWithTheSameState) {
 TEST(SceneFiles, ViewTableIsReadWithItsDefaults) {
   const core::SceneDescription plain = scene_io::parse_scene("format_version = 1\nname = \"v\"\n", "plain.toml");
   EXPECT_FALSE(plain.view.region_of_interest.has_value());
-  EXPECT_EQ(plain.view.gel_stain, core::GelStain::kNone);
+  EXPECT_EQ(plain.view.gel_stain, core::GelStain::kClear);
   EXPECT_FALSE(plain.view.wide_angle);
   EXPECT_FALSE(plain.view.chandelier);
   const core::SceneDescription v = scene_io::parse_scene(

@@ -39,7 +39,10 @@ bool place_at_fixed_poses(SimulationModel& model) {
   const core::Vec3 lp = c.tracker_ports[kLightPipeTracker].position_mm;
   const core::Vec3 tp = c.tracker_ports[kToolTracker].position_mm;
   if (!model.apply(tracker_sample(kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0))) return false;
-  if (!model.apply(tracker_sample(kToolTracker, tp + 5.0 * (c.focus_mm - tp).normalized(), 0.0))) return false;
+  // The tool aimed at the region of interest from its port, its tip short of it (its handle a
+  // third closed): working tips, the laser's aiming spot and the shadows all lie in the field.
+  const core::Vec3 tool_tip = c.focus_mm - kToolClearance_mm * (c.focus_mm - tp).normalized();
+  if (!model.apply(tracker_sample(kToolTracker, tool_tip, kToolActuation))) return false;
   for (int i = 0; i < 3; ++i) model.step();
   return true;
 }

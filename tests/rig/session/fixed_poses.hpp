@@ -1,8 +1,9 @@
 #pragma once
 // The fixed instrument poses the case golden test and the per-case frame benchmark share: tracker
 // samples as the tracker driver delivers them, and the standard framing of a case — the light pipe
-// 6 mm into its port and the first tool 5 mm into its own, both aimed at the case's region of
-// interest, jaws open, settled for three steps.
+// 6 mm into its port aimed at the case's region of interest, the first tool through its own port
+// aimed at that region with its tip 3 mm short of it (handle a third closed), settled for three
+// steps; the microscope starts centred on the region of interest.
 #include <memory>
 #include <string>
 
@@ -23,6 +24,9 @@ struct CaseUnderTest {
 // A tracker sample for instrument `id` with its tip at `tip` (eye-fixture frame); the orientation
 // is left to the port (the shaft is rebuilt from the port through the tip).
 telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation);
+
+inline constexpr double kToolClearance_mm = 3.0;
+inline constexpr double kToolActuation = 0.3;
 
 // Applies the standard poses and steps three times; false if the model refused an input.
 bool place_at_fixed_poses(SimulationModel& model);
