@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/anatomy/fundus_texture.hpp"
 #include "fixed_poses.hpp"
 #include "rig/session/frame_source.hpp"
 #include "vitreo/render/egl_context.hpp"
@@ -34,7 +35,31 @@ int main(int argc, char** argv) {
   app.add_option("--case", names, "case name(s) in scenes/ (default: all)");
   app.add_option("--size", size, "per-eye size WxH");
   app.add_option("--retina", retina, "retina vertices");
+  std::vector<std::uint64_t> fundus_seeds;
+  app.add_option("--fundus", fundus_seeds, "instead: write the fundus (retina map over choroid map) of these texture seeds");
   CLI11_PARSE(app, argc, argv);
+  if (!fundus_seeds.empty()) {
+    std::filesystem::create_directories(out);
+    core::EyeParameters p;
+    p.retina_vertices = 1000;
+    const core::EyeModel eye = core::build_eye_model(p);
+    for (const std::uint64_t seed : fundus_seeds) {
+      const core::FundusTextures t = core::generate_fundus(eye, {seed, 512});
+      vr::Image img{t.retina.width, t.retina.height, t.choroid.rgba};
+      for (std::size_t i = 0; i < img.rgba.size(); i += 4) {
+        const double a = t.retina.rgba[i + 3] / 255.0;
+        for (int k = 0; k < 3; ++k) img.rgba[i + k] = static_cast<std::uint8_t>(std::lround(t.retina.rgba[i + k] * a + img.rgba[i + k] * (1 - a)));
+      }
+      // Row 0 is v = 0 (inferior): flip so superior is up, as the surgeon's picture has it.
+      vr::Image flipped = img;
+      const std::size_t row = static_cast<std::size_t>(img.width) * 4;
+      for (int y = 0; y < img.height; ++y) std::copy_n(&img.rgba[y * row], row, &flipped.rgba[(img.height - 1 - y) * row]);
+      const std::string path = out + "/fundus_seed_" + std::to_string(seed) + ".png";
+      vr::write_png(path, flipped);
+      std::printf("%s\n", path.c_str());
+    }
+    return 0;
+  }
   int w = 0, h = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16) {
     std::fprintf(stderr, "case_view: --size must be WxH, got '%s'\n", size.c_str());
