@@ -14,7 +14,7 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 // Vessel colours (linear 0..1): oxygenated arterial blood is a brighter red, venous blood darker
 // and bluer.
-constexpr double kArtery[3] = {0.80, 0.16, 0.10};
+constexpr double kArtery[3] = {0.74, 0.14, 0.10};
 constexpr double kVein[3] = {0.42, 0.05, 0.09};
 
 // splitmix64: tiny, portable, and the same bits everywhere (std distributions are not).
@@ -277,8 +277,12 @@ FundusTextures generate_fundus(const EyeModel& eye, const FundusOptions& o) {
           if (cover <= 0.0) continue;
           std::uint8_t* px = t.retina.pixel(x, y);
           blend(px, rr, gg, bb, 0.95 * cover);
-          // The arterial reflex: a lighter stripe a quarter of the vessel wide along its centre.
-          if (s.artery && d < 0.125 * s.width_mm && s.width_mm > 1.5 * mm_per_px) blend(px, 0.95, 0.55, 0.45, 0.6 * cover);
+          // The arterial reflex: a lighter stripe a third of the vessel wide along its centre (only
+          // where the vessel spans enough texels to carry it without aliasing into dots).
+          if (s.artery && s.width_mm > 3.0 * mm_per_px) {
+            const double reflex = std::clamp((0.17 * s.width_mm + 0.5 * mm_per_px - d) / mm_per_px, 0.0, 1.0);
+            if (reflex > 0.0) blend(px, 0.92, 0.50, 0.40, 0.45 * reflex);
+          }
         }
       }
     }

@@ -248,7 +248,7 @@ void main() {
     float radiance = spot(u_light_position, u_light_direction, u_cos_outer, u_cos_inner, u_light_intensity, u_light_range, l);
 #if SHADOWS
     // Shadowed tissue still gets the light the lit fundus scatters back into the cavity.
-    radiance *= mix(0.15, 1.0, shadow_factor());
+    radiance *= mix(0.22, 1.0, shadow_factor());
 #endif
     float nl = dot(n, l);
     float diffuse = max(nl, 0.0) + translucency * max(-nl, 0.0) + scatter * (1.0 - abs(nl));

@@ -17,6 +17,7 @@
 
 #include "core/anatomy/fundus_texture.hpp"
 #include "fixed_poses.hpp"
+#include "synthetic_scene.hpp"
 #include "rig/session/frame_source.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/png_io.hpp"
@@ -35,6 +36,17 @@ int main(int argc, char** argv) {
   app.add_option("--case", names, "case name(s) in scenes/ (default: all)");
   app.add_option("--size", size, "per-eye size WxH");
   app.add_option("--retina", retina, "retina vertices");
+  double zoom = 0.0, focus = 0.0, actuation = -1.0;
+  std::vector<double> pan;
+  bool wide = false, invert = false, no_labels = false, flat = false;
+  app.add_option("--zoom", zoom, "microscope zoom (operator command)");
+  app.add_option("--pan", pan, "microscope pan X Y (mm from the region of interest)")->expected(2);
+  app.add_option("--focus", focus, "microscope focus offset (mm, + toward the microscope)");
+  app.add_option("--actuation", actuation, "the tool's handle, 0 open .. 1 closed");
+  app.add_flag("--wide", wide, "wide-angle viewing system");
+  app.add_flag("--invert", invert, "with --wide: re-inverter off");
+  app.add_flag("--no-labels", no_labels, "hide guides and labels");
+  app.add_flag("--flat", flat, "flat shading");
   std::vector<std::uint64_t> fundus_seeds;
   app.add_option("--fundus", fundus_seeds, "instead: write the fundus (retina map over choroid map) of these texture seeds");
   CLI11_PARSE(app, argc, argv);
@@ -78,19 +90,47 @@ int main(int argc, char** argv) {
   for (const std::string& name : names) {
     rig::testing::CaseUnderTest under_test(scenes + "/" + name + ".toml", retina,
                                            (std::filesystem::temp_directory_path() / "vitreo-case-view-cache").string());
-    if (!rig::testing::place_at_fixed_poses(under_test.model)) {
+    rig::SimulationModel& model = under_test.model;
+    auto command = [&](int code, double a, double b) {
+      telemetry::DeviceInput in;
+      in.device_kind = rig::kCommandKind;
+      in.n_values = 3;
+      in.values[0] = code, in.values[1] = a, in.values[2] = b;
+      return model.apply(in);
+    };
+    if (zoom > 0.0) command(9, zoom, 0);
+    if (pan.size() == 2) command(10, pan[0], pan[1]);
+    if (focus != 0.0) command(11, focus, 0);
+    if (flat) command(12, 0, 0);
+    if (wide) command(13, 0, 0);
+    if (invert) command(14, 0, 0);
+    if (no_labels) command(8, 0, 0);
+    if (!rig::testing::place_at_fixed_poses(model)) {
       std::fprintf(stderr, "case_view: %s: poses refused\n", name.c_str());
       return 1;
     }
+    if (actuation >= 0.0) {
+      const auto& c = model.current_case();
+      const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
+      model.apply(rig::testing::tracker_sample(rig::kToolTracker, c.focus_mm - rig::testing::kToolClearance_mm * (c.focus_mm - tp).normalized(), actuation));
+      model.step();
+    }
+    // The microscope's motors reach their targets (the tissue steps along).
+    for (int i = 0; i < 4000 && (std::abs(model.microscope().zoom() - (zoom > 0 ? zoom : 1.0)) > 1e-9 ||
+                                 std::abs(model.microscope().focus_mm() - focus) > 1e-9 ||
+                                 (pan.size() == 2 && (model.microscope().center_mm() - model.microscope().region_of_interest_mm() - core::Vec2(pan[0], pan[1])).norm() > 1e-6));
+         ++i) {
+      model.step();
+    }
     rig::ViewSnapshot view;
-    if (!rig::capture_view(under_test.model, 3, 0.003, view)) return 1;
+    if (!rig::capture_view(model, 3, 0.003, view)) return 1;
     rig::FrameBuilder builder;
     vr::FrameScene scene = builder.build(view);
     if (const char* drop = std::getenv("CASE_VIEW_DROP")) {  // debugging: leave one material out
       std::erase_if(scene.meshes, [&](const vr::Mesh& m) { return static_cast<int>(m.material) == std::atoi(drop); });
     }
     if (std::getenv("CASE_VIEW_DEBUG")) {
-      const auto disc = under_test.model.scene().eye.optic_disc_mm;
+      const auto disc = model.scene().eye.optic_disc_mm;
       for (const auto& m : scene.meshes) {
         if (m.material != vr::MaterialKind::Retina) continue;
         int n = 0;
@@ -102,8 +142,8 @@ int main(int argc, char** argv) {
     }
     for (const auto& ins : view.instruments) {
       if (!ins.present) continue;
-      std::printf("  instrument kind %d inserted %d tip (%.2f %.2f %.2f) aim_hit %d aim (%.2f %.2f %.2f)\n", ins.kind, ins.inserted,
-                  ins.tip[0], ins.tip[1], ins.tip[2], ins.aim_hit, ins.aim_point[0], ins.aim_point[1], ins.aim_point[2]);
+      const vr::Vec2 px = render::testing::project_to_pixel(scene, 0, vr::Vec3{ins.tip[0], ins.tip[1], ins.tip[2]}, w, h);
+      std::printf("  instrument kind %d inserted %d tip at pixel (%.0f, %.0f) aim_hit %d\n", ins.kind, ins.inserted, px.x, px.y, ins.aim_hit);
     }
     vr::StereoFrame frame;
     renderer.render(scene, frame);
