@@ -135,20 +135,22 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
       const float half = static_cast<float>(d.jaw_open_deg) * kPi / 180.0f * (1.0f - std::clamp(v.actuation, 0.0f, 1.0f));
       const float jr = static_cast<float>(d.jaw_radius_mm);
       const Vec3 hinge{0, 0, -J};
+      out.push_back(make_mesh(metal, id++, MaterialKind::Instrument, model, version));
+      Builder jaws;  // their own mesh: what the handle moves
       for (float side : {1.0f, -1.0f}) {
         const Vec3 along{side * std::sin(half), 0.0f, std::cos(half)};
         if (v.kind == K::kForceps) {
           // End-gripping jaws: flat faces toward each other (across y), 2·jaw_radius thick, so the
           // gap between their faces is the core's jaw gap; a grasping platform at the end.
-          metal.plate(hinge, Vec3{0, 1, 0}, along, {{-0.13f, 0.0f}, {0.13f, 0.0f}, {0.09f, J}, {-0.09f, J}}, 2.0f * jr);
+          jaws.plate(hinge, Vec3{0, 1, 0}, along, {{-0.13f, 0.0f}, {0.13f, 0.0f}, {0.09f, J}, {-0.09f, J}}, 2.0f * jr);
         } else {
           // Scissors: pointed blades in the opening plane, offset across so they shear past each other.
           const Vec3 across{std::cos(half), 0.0f, -side * std::sin(half)};
-          metal.plate(hinge + Vec3{0, side * 0.5f * jr, 0}, across * side, along,
-                      {{-0.03f, 0.0f}, {0.12f, 0.0f}, {0.0f, J}, {-0.03f, 0.85f * J}}, jr);
+          jaws.plate(hinge + Vec3{0, side * 0.5f * jr, 0}, across * side, along,
+                     {{-0.03f, 0.0f}, {0.12f, 0.0f}, {0.0f, J}, {-0.03f, 0.85f * J}}, jr);
         }
       }
-      out.push_back(make_mesh(metal, id++, MaterialKind::Instrument, model, version, v.kind == K::kForceps ? kDarkSteel : kSteel));
+      out.push_back(make_mesh(jaws, id++, MaterialKind::Instrument, model, version, v.kind == K::kForceps ? kDarkSteel : kSteel));
       break;
     }
     case K::kVitrector: {

@@ -129,17 +129,6 @@ int main(int argc, char** argv) {
     if (const char* drop = std::getenv("CASE_VIEW_DROP")) {  // debugging: leave one material out
       std::erase_if(scene.meshes, [&](const vr::Mesh& m) { return static_cast<int>(m.material) == std::atoi(drop); });
     }
-    if (std::getenv("CASE_VIEW_DEBUG")) {
-      const auto disc = model.scene().eye.optic_disc_mm;
-      for (const auto& m : scene.meshes) {
-        if (m.material != vr::MaterialKind::Retina) continue;
-        int n = 0;
-        for (const auto& v : m.geometry->vertices) {
-          const double d = std::hypot(v.position_mm.x - disc.x(), v.position_mm.y - disc.y(), v.position_mm.z - disc.z());
-          if (d < 1.5 && n++ < 12) std::printf("  disc vertex d %.2f detachment %.2f highlight %.2f\n", d, v.detachment, v.highlight);
-        }
-      }
-    }
     for (const auto& ins : view.instruments) {
       if (!ins.present) continue;
       const vr::Vec2 px = render::testing::project_to_pixel(scene, 0, vr::Vec3{ins.tip[0], ins.tip[1], ins.tip[2]}, w, h);

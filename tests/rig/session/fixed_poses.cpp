@@ -21,16 +21,35 @@ CaseUnderTest::CaseUnderTest(const std::string& scene_file, int retina_vertices,
     : loader({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir), /*visuals=*/true),
       model(model_config({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir)), loader.load_now(0)) {}
 
-telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation) {
+telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation, const core::Quat& orientation) {
   telemetry::DeviceInput in;
   in.device_kind = static_cast<std::int8_t>(InputKind::Tracker);
   in.n_values = 11;
   in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
-  in.values[3] = 1.0;  // orientation: the shaft is rebuilt from the port through the tip
+  // Orientation: the shaft is rebuilt from the port through the tip; the x axis gives the roll.
+  in.values[3] = orientation.w(), in.values[4] = orientation.x(), in.values[5] = orientation.y(), in.values[6] = orientation.z();
   in.values[7] = actuation;
   in.values[8] = 1.0;
   in.values[9] = id;
   in.values[10] = 3;
+  return in;
+}
+
+telemetry::DeviceInput command_input(int code, double a, double b) {
+  telemetry::DeviceInput in;
+  in.device_kind = kCommandKind;
+  in.n_values = 3;
+  in.values[0] = code, in.values[1] = a, in.values[2] = b;
+  return in;
+}
+
+telemetry::DeviceInput pedal_input(int pedal, double a0, double a1, double a2, double a3, int switches) {
+  telemetry::DeviceInput in;
+  in.device_kind = static_cast<std::int8_t>(InputKind::Pedals);
+  in.n_values = 7;
+  in.values[0] = pedal, in.values[1] = 4;
+  in.values[2] = a0, in.values[3] = a1, in.values[4] = a2, in.values[5] = a3;
+  in.values[6] = switches;
   return in;
 }
 
