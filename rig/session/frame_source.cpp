@@ -211,8 +211,12 @@ std::unique_ptr<CaseVisuals> build_case_visuals(const PreparedCase& c) {
   };
   label(s.eye.fovea_mm, "fovea");
   label(s.eye.optic_disc_mm, "optic disc");
-  for (const auto& t : s.description.tears) label(on_wall(s.eye, t.center), t.name + " tear");
-  for (const auto& m : s.description.membranes) label(on_wall(s.eye, m.center), m.name + " membrane");
+  // "horseshoe tear", "erm membrane" — but "tear", not "tear tear".
+  auto named = [](const std::string& name, const std::string& kind) {
+    return name.find(kind) == std::string::npos ? name + " " + kind : name;
+  };
+  for (const auto& t : s.description.tears) label(on_wall(s.eye, t.center), named(t.name, "tear"));
+  for (const auto& m : s.description.membranes) label(on_wall(s.eye, m.center), named(m.name, "membrane"));
   for (const auto& d : s.description.detachments) label(on_wall(s.eye, d.center), d.name);
   // A boundary of the retina near the ora is where the retina ends, not a cut.
   v->retina_edge_polar_rad = s.eye.ora_polar_rad - 1.5 * kDeg;

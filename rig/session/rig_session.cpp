@@ -208,6 +208,8 @@ SessionSummary run_session(const SessionConfig& config) {
     ro.png_dir = config.png_dir;
     ro.png_every_frames = config.png_every_frames;
     ro.displays = config.displays;
+    ro.shm_ring_name = config.frame_ring_name;
+    ro.instructor_ring_name = config.instructor_ring_name;
     renderer = std::make_unique<render::RenderThread>(ro);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));

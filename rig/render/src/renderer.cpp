@@ -693,16 +693,18 @@ struct StereoRenderer::Impl {
     for (std::size_t i = 0; i < scene.labels.size(); ++i) {
       float px = 0, py = 0;
       if (!project(0, scene.labels[i], px, py)) continue;
-      const float x0 = px + 3.0f * m, w = static_cast<float>(font::text_width(scene.labels[i].text, static_cast<int>(scale)));
+      // The box: from the marker to a glyph's width past the text, so neighbours keep a gap.
+      const float x0 = px - m - scale, w = static_cast<float>(font::text_width(scene.labels[i].text, static_cast<int>(scale)));
+      const float x1 = px + 3.0f * m + w + font::kAdvance * scale;
       float y0 = py - 0.5f * font::kGlyphHeight * scale;
       for (int tries = 0; tries < 8; ++tries) {
         bool clear = true;
-        for (const auto& b : label_boxes) clear = clear && (x0 + w < b[0] || x0 > b[2] || y0 + line <= b[1] || y0 >= b[3]);
+        for (const auto& b : label_boxes) clear = clear && (x1 < b[0] || x0 > b[2] || y0 + line <= b[1] || y0 >= b[3]);
         if (clear) break;
         y0 += line;
         label_offsets[i] += line;
       }
-      label_boxes.push_back({x0, y0, x0 + w, y0 + line});
+      label_boxes.push_back({x0, y0, x1, y0 + line});
     }
     for (int e = 0; e < 2; ++e) {
       text_quads.clear();
