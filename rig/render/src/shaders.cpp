@@ -134,6 +134,19 @@ float spot(vec3 position, vec3 direction, float cos_outer, float cos_inner, floa
   return intensity * cone / (1.0 + (d / range) * (d / range));
 }
 
+// What a light of `radiance` arriving from direction l adds at this fragment: diffuse (with light
+// through the sheet from behind and light scattered whatever the facing) and a Blinn-Phong highlight.
+vec3 shade(float radiance, vec3 l, vec3 n, vec3 v, vec3 albedo, float specular, vec3 spec_colour, float translucency, float scatter) {
+  float nl = dot(n, l);
+  float diffuse = max(nl, 0.0) + translucency * max(-nl, 0.0) + scatter * (1.0 - abs(nl));
+#if MATERIAL == 4
+  diffuse = 0.35 * scatter;  // gel: volume scattering, no surface facing
+#endif
+  vec3 h = normalize(l + v);
+  float spec = specular * pow(max(dot(n, h), 0.0), u_shininess) * (nl > 0.0 ? 1.0 : 0.0);
+  return radiance * (albedo * diffuse * 1.6 + spec_colour * spec);
+}
+
 // Cheap value noise on a lattice (membrane fibres, retina sheen): a hash per corner, smoothed.
 float hash2(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
 float value_noise(vec2 p) {
@@ -250,14 +263,7 @@ void main() {
     // Shadowed tissue still gets the light the lit fundus scatters back into the cavity.
     radiance *= mix(0.22, 1.0, shadow_factor());
 #endif
-    float nl = dot(n, l);
-    float diffuse = max(nl, 0.0) + translucency * max(-nl, 0.0) + scatter * (1.0 - abs(nl));
-#if MATERIAL == 4
-    diffuse = 0.35 * scatter;
-#endif
-    vec3 h = normalize(l + v);
-    float spec = specular * pow(max(dot(n, h), 0.0), u_shininess) * (nl > 0.0 ? 1.0 : 0.0);
-    lit += radiance * (albedo * diffuse * 1.6 + spec_colour * spec);
+    lit += shade(radiance, l, n, v, albedo, specular, spec_colour, translucency, scatter);
     haze_light += kHazeColour * 0.12 * u_light_intensity;  // light scattered by the whole lit cavity
   }
   // Light bounced off the lit fundus: metal reflects it (instruments are not black silhouettes),
@@ -274,14 +280,7 @@ void main() {
   {
     vec3 l;
     float radiance = spot(u_light2_position, u_light2_direction, u_light2_cos_outer, u_light2_cos_inner, u_light2_intensity, u_light2_range, l);
-    float nl = dot(n, l);
-    float diffuse = max(nl, 0.0) + translucency * max(-nl, 0.0) + scatter * (1.0 - abs(nl));
-#if MATERIAL == 4
-    diffuse = 0.35 * scatter;
-#endif
-    vec3 h = normalize(l + v);
-    float spec = specular * pow(max(dot(n, h), 0.0), u_shininess) * (nl > 0.0 ? 1.0 : 0.0);
-    lit += radiance * (albedo * diffuse * 1.6 + spec_colour * spec);
+    lit += shade(radiance, l, n, v, albedo, specular, spec_colour, translucency, scatter);
     haze_light += kHazeColour * 0.08 * u_light2_intensity;
   }
 #endif

@@ -38,4 +38,13 @@ Image rotate180(const Image& img);
 // [x0, x1) × [y0, y1): how much edge and texture detail a region has (blur lowers it).
 double detail(const Image& img, int x0, int y0, int x1, int y1);
 
+// Taking a cue away, to see what it changed: the scene without the meshes `drop` picks; the scene
+// with no retina shaded as detached (the detachment cue off, the geometry unchanged).
+template <class Pred>
+FrameScene without(FrameScene s, Pred drop) {
+  std::erase_if(s.meshes, drop);
+  return s;
+}
+FrameScene without_detachment_shading(FrameScene s);
+
 }  // namespace vitreo::render::testing

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "image_checks.hpp"
+#include "render_fixture.hpp"
 #include "synthetic_scene.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/frame_ring.hpp"
@@ -29,22 +30,7 @@ namespace {
 
 constexpr int kW = 200, kH = 160;
 
-class ViewCues : public ::testing::Test {
- protected:
-  void SetUp() override {
-    vr::EglOptions o;
-    o.honour_environment = false;
-    context_ = std::make_unique<vr::EglContext>(o);
-    renderer_ = std::make_unique<vr::StereoRenderer>(vr::RenderSettings{kW, kH, 512, 512});
-  }
-  vr::StereoFrame render(const vr::FrameScene& s) {
-    vr::StereoFrame f;
-    renderer_->render(s, f);
-    return f;
-  }
-  std::unique_ptr<vr::EglContext> context_;
-  std::unique_ptr<vr::StereoRenderer> renderer_;
-};
+using ViewCues = vt::RendererFixture<kW, kH>;
 
 vr::FrameScene base_scene() {
   vt::SyntheticOptions o;

@@ -43,15 +43,6 @@ namespace {
 constexpr int kW = 160, kH = 128;
 const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
 
-std::vector<std::string> case_names() {
-  std::vector<std::string> out;
-  for (const auto& e : std::filesystem::directory_iterator(kScenes)) {
-    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") out.push_back(e.path().stem().string());
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 struct Rgb {
   double r = 0, g = 0, b = 0;
   double luma() const { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
@@ -264,14 +255,7 @@ TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
     if (off < best_off) best_off = off, best = v.position_mm;
   }
   ASSERT_LT(best_off, 1e8f);
-  vr::FrameScene flat = scene;
-  for (auto& m : flat.meshes) {
-    if (m.material != vr::MaterialKind::Retina) continue;
-    auto g = std::make_shared<vr::MeshGeometry>(*m.geometry);
-    for (auto& v : g->vertices) v.detachment = 0.0f;
-    m.geometry = g;
-    m.geometry_version += 1000000;
-  }
+  vr::FrameScene flat = render::testing::without_detachment_shading(scene);
   const vr::Vec2 px = render::testing::project_to_pixel(scene, 0, best, kW, kH);
   flat.labels.clear();
   const Rgb shaded = patch(left_nolabels, px, 1), unshaded = patch(render_stereo(flat).eye(0), px, 1);
@@ -281,7 +265,7 @@ TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
       << "detached retina looks greyer";
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryCase, CaseFrames, ::testing::ValuesIn(case_names()),
+INSTANTIATE_TEST_SUITE_P(EveryCase, CaseFrames, ::testing::ValuesIn(rig::testing::shipped_case_names()),
                          [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 // The operator's view toggles reach the picture: wireframe draws the tissue's edges, zoom narrows

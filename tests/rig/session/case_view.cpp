@@ -78,12 +78,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string scenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
-  if (names.empty()) {
-    for (const auto& e : std::filesystem::directory_iterator(scenes)) {
-      if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") names.push_back(e.path().stem().string());
-    }
-    std::sort(names.begin(), names.end());
-  }
+  if (names.empty()) names = rig::testing::shipped_case_names();
   std::filesystem::create_directories(out);
   vr::EglContext context;
   vr::StereoRenderer renderer(vr::RenderSettings{w, h, 1024, 1024});

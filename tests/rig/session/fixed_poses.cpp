@@ -1,5 +1,8 @@
 #include "fixed_poses.hpp"
 
+#include <algorithm>
+#include <filesystem>
+
 namespace vitreo::rig::testing {
 
 namespace {
@@ -20,6 +23,15 @@ ModelConfig model_config(const std::vector<scene_io::CaseText>& cases, const sce
 CaseUnderTest::CaseUnderTest(const std::string& scene_file, int retina_vertices, const std::string& cache_dir)
     : loader({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir), /*visuals=*/true),
       model(model_config({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir)), loader.load_now(0)) {}
+
+std::vector<std::string> shipped_case_names() {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(VITREO_SOURCE_DIR) + "/scenes")) {
+    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") out.push_back(e.path().stem().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
 
 telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation, const core::Quat& orientation) {
   telemetry::DeviceInput in;

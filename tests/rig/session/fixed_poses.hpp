@@ -6,12 +6,16 @@
 // steps; the microscope starts centred on the region of interest.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/common/types.hpp"
 #include "rig/session/case_switcher.hpp"
 #include "rig/session/simulation_model.hpp"
 
 namespace vitreo::rig::testing {
+
+// The shipped cases: the *.toml files of scenes/ other than the materials library, by name, sorted.
+std::vector<std::string> shipped_case_names();
 
 // One case from scenes/ loaded the way a session loads it, with its look (visuals) for rendering;
 // the loader owns the case's static meshes and textures, so it lives as long as the model.

@@ -72,12 +72,6 @@ std::unique_ptr<rig::testing::CaseUnderTest> load(const std::string& name) {
                                                          std::string(VITREO_CASE_CACHE_DIR));
 }
 
-// The scene without the meshes `drop` says.
-vr::FrameScene without(vr::FrameScene s, auto drop) {
-  std::erase_if(s.meshes, drop);
-  return s;
-}
-
 }  // namespace
 
 // The laser ring of the laser exercise is drawn where the case defines it (on the fundus around the
@@ -192,7 +186,7 @@ TEST_F(CaseCues, AimingSpotSitsAtTheLasersRayHit) {
   ASSERT_TRUE(model.apply(rig::testing::command_input(8)));  // no labels over the spot
   const vr::FrameScene scene = capture(model, builder);
   // The spot is the glow placed in the eye frame (identity placement) at the hit.
-  const vr::FrameScene no_spot = without(scene, [](const vr::Mesh& m) {
+  const vr::FrameScene no_spot = vt::without(scene, [](const vr::Mesh& m) {
     return m.material == vr::MaterialKind::Glow && m.model.m == vr::Mat4::identity().m;
   });
   ASSERT_EQ(no_spot.meshes.size() + 1, scene.meshes.size());
@@ -243,7 +237,7 @@ TEST_F(CaseCues, ForcepsJawGapInTheImageFollowsTheHandle) {
     for (auto& mesh : s.meshes) mesh.casts_shadow = false;  // the jaws' own pixels, not their shadow
     const vr::Image with = render(s, kW, kH).eye(0);
     // The jaws: the tool's second mesh (frame_source ids: 200 + its slot, then its parts in order).
-    const vr::Image none = render(without(s, [](const vr::Mesh& m) { return m.id % 1000 == 201; }), kW, kH).eye(0);
+    const vr::Image none = render(vt::without(s, [](const vr::Mesh& m) { return m.id % 1000 == 201; }), kW, kH).eye(0);
     const vt::Mask tool = vt::diff_mask(with, none, 12);
     // In the image: each jaw's pixels on its side of the shaft's axis; the jaw's tip is its pixel
     // farthest from the hinge. Their distance is the opening the surgeon sees.
@@ -290,7 +284,7 @@ TEST_F(CaseCues, DetachedRetinaIsGreyerAndItsDisparitySaysItIsNearer) {
   ASSERT_TRUE(model.apply(rig::testing::command_input(8)));  // labels off: they would be matched too
   rig::FrameBuilder builder;
   vr::FrameScene scene = capture(model, builder);
-  scene = without(scene, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Instrument || m.material == vr::MaterialKind::Glow; });
+  scene = vt::without(scene, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Instrument || m.material == vr::MaterialKind::Glow; });
   scene.microscope.depth_of_field = false;  // sharp in both eyes, for the matching
   constexpr int kW = 320, kH = 256;
   const vr::StereoFrame f = render(scene, kW, kH);
@@ -346,13 +340,7 @@ TEST_F(CaseCues, DetachedRetinaIsGreyerAndItsDisparitySaysItIsNearer) {
   EXPECT_NEAR(measured, lifted, 0.75);
   EXPECT_GT(measured, on_wall + 0.5 * (lifted - on_wall)) << "nearer than the wall (crossed disparity)";
   // Greyer than the same frame without the detachment shading.
-  vr::FrameScene flat = scene;
-  for (auto& m : flat.meshes) {
-    if (m.material != vr::MaterialKind::Retina) continue;
-    auto g = std::make_shared<vr::MeshGeometry>(*m.geometry);
-    for (auto& v : g->vertices) v.detachment = 0.0f;
-    m.geometry = g;
-  }
+  const vr::FrameScene flat = vt::without_detachment_shading(scene);
   const vt::Rgb shaded = vt::patch(left, l, 2), unshaded = vt::patch(render(flat, kW, kH).eye(0), l, 2);
   std::printf("detached patch saturation %.2f vs %.2f without the shading\n", shaded.spread() / shaded.luma(), unshaded.spread() / unshaded.luma());
   EXPECT_LT(shaded.spread() / shaded.luma(), 0.8 * unshaded.spread() / unshaded.luma());
@@ -424,7 +412,7 @@ TEST_F(CaseCues, GelHazeIsGoneWhereTheVitrectorRemovedGel) {
   constexpr int kW = 320, kH = 256;
   auto gel_only = [](vr::FrameScene s) {  // the retina and choroid beneath, the gel: nothing moving in front
     s.microscope.depth_of_field = false;
-    return without(s, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Instrument || m.material == vr::MaterialKind::Glow ||
+    return vt::without(s, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Instrument || m.material == vr::MaterialKind::Glow ||
                                                       (m.material == vr::MaterialKind::Static && m.id % 1000 > 50); });
   };
   const vr::Image a = render(gel_only(before), kW, kH).eye(0), b = render(gel_only(after), kW, kH).eye(0);
@@ -456,7 +444,7 @@ TEST_F(CaseCues, TornEdgeRollsWhiterAlongItsEdgeOnly) {
   ASSERT_TRUE(model.apply(rig::testing::command_input(8)));
   rig::FrameBuilder builder;
   vr::FrameScene scene = capture(model, builder);
-  scene = without(scene, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Instrument || m.material == vr::MaterialKind::Glow; });
+  scene = vt::without(scene, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Instrument || m.material == vr::MaterialKind::Glow; });
   vr::FrameScene plain = scene;
   std::vector<vr::Vec3> rim, band;
   double edge_mm = 0.0;
