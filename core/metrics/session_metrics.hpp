@@ -74,6 +74,9 @@ class SessionMetrics final : public StepObserver {
   bool complete();
   // Criteria, then the scores (no allocation).
   const ScoreCard& score();
+  // What the last score() / criteria() found, without measuring again (the picture shows these).
+  const ScoreCard& last_score() const { return card_; }
+  const CaseProgress& progress() const { return progress_; }
 
  private:
   const TissueWorld& world_;

@@ -220,13 +220,19 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-render", render, "no stereo frames (EGL) at all");
   auto* stdin_opt = app.add_flag("--commands-from-stdin", commands_from_stdin,
                "read operator commands from stdin even when it is not a terminal (a pipe, a script); when it is a\n"
-               "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X");
+               "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X,\n"
+               "pan X Y, focus F, flat, wide, invert");
   std::vector<std::string> displays;
   auto* display_opt = app.add_option("--display", displays,
                  "show the frames on a rig display through KMS: CARD[:CONNECTOR[:sbs|left|right]], e.g.\n"
                  "/dev/dri/card0:HDMI-A-1:left (repeatable: one per eyepiece display; default: first connected, side by side)");
   app.add_option("--eye-size", eye_width, "width of each eye's image in pixels (height = 4/5 of it)")
       ->check(CLI::Range(64, 4096));
+  std::string frame_ring, instructor_ring;
+  app.add_option("--frame-ring", frame_ring, "publish the stereo frames in this shared-memory ring (e.g. /vitreo-frames)");
+  app.add_option("--instructor-ring", instructor_ring,
+                 "publish the instructor's view (left eye, score, retina force, events) in this shared-memory ring\n"
+                 "(e.g. /vitreo-instructor); it is also written beside the frames as step_*_instructor.png");
   // A replay takes its cases, resolution and length from the recording: options that would choose
   // them are refused rather than silently ignored.
   for (CLI::Option* o : {case_opt, cases_opt, start_opt, retina_opt, texture_opt, duration_opt, serial_opt, rig_option, lcm_opt, realtime_opt,
@@ -306,13 +312,15 @@ int main(int argc, char** argv) {
     config.render = render;
     if (commands_from_stdin || ::isatty(STDIN_FILENO)) {
       config.command_fd = STDIN_FILENO;
-      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X — one per line\n");
+      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X pan X Y focus F flat wide invert — one per line\n");
       std::fflush(stdout);
     }
     config.eye_width = eye_width;
     config.eye_height = eye_width * 4 / 5;
     config.png_dir = (out / "frames").string();
     config.png_every_frames = 10;
+    config.frame_ring_name = frame_ring;
+    config.instructor_ring_name = instructor_ring;
     if (render) fs::create_directories(config.png_dir);
     for (const auto& d : displays) config.displays.push_back(parse_display(d));
     if (!config.displays.empty() && !render) throw std::runtime_error("--display needs rendering (drop --no-render)");
@@ -431,6 +439,8 @@ int main(int argc, char** argv) {
       std::printf("  frames           %llu stereo frames %dx%d per eye (%s); %zu written to %s, the last: %s\n",
                   static_cast<unsigned long long>(s.frames_rendered), config.eye_width, config.eye_height, s.renderer.c_str(),
                   s.pngs.size(), config.png_dir.c_str(), s.pngs.empty() ? "none" : (s.pngs.back() + "_stereo.png").c_str());
+      std::printf("  instructor view  %s%s\n", s.pngs.empty() ? "none" : (s.pngs.back() + "_instructor.png").c_str(),
+                  instructor_ring.empty() ? "" : (" and the shared-memory ring " + instructor_ring).c_str());
     }
     for (const auto& line : s.displays) std::printf("  display          %s\n", line.c_str());
     for (std::size_t i = 0; i < s.score_lines.size(); ++i)

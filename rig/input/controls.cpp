@@ -34,6 +34,14 @@ bool PedalMapper::apply(const PedalReading& r) {
   } else if (r.pedal_id == m_.microscope_pedal_id) {
     c_.zoom = m_.zoom_min + axis(m_.zoom_axis) * (m_.zoom_max - m_.zoom_min);
     c_.focus_offset_mm = (axis(m_.focus_axis) - 0.5) * m_.focus_range_mm;
+    // Joystick axes read 0.5 when absent: centred, so a two-axis pedal never drifts the field.
+    auto deflection = [&](int index) {
+      const double d = 2.0 * ((index >= 0 && index < r.axis_count ? r.axes[index] : 0.5) - 0.5);
+      const double beyond = std::max(0.0, std::abs(d) - m_.pan_deadband) / (1.0 - m_.pan_deadband);
+      return d < 0.0 ? -beyond : beyond;
+    };
+    c_.pan_x = deflection(m_.pan_x_axis);
+    c_.pan_y = deflection(m_.pan_y_axis);
     if (bit(r.switches, m_.light_up_switch) && !bit(last_switches_[1], m_.light_up_switch)) {
       c_.light_level = std::min(1.0, c_.light_level + m_.light_step);
     }
@@ -80,6 +88,9 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
       {"zoom_min", {&m.zoom_min, nullptr, 0.1, 40}},
       {"zoom_max", {&m.zoom_max, nullptr, 0.1, 40}},
       {"focus_range_mm", {&m.focus_range_mm, nullptr, 0, 40}},
+      {"pan_x_axis", {nullptr, &m.pan_x_axis, -1, 3}},
+      {"pan_y_axis", {nullptr, &m.pan_y_axis, -1, 3}},
+      {"pan_deadband", {&m.pan_deadband, nullptr, 0, 0.9}},
       {"light_up_switch", {nullptr, &m.light_up_switch, -1, 15}},
       {"light_down_switch", {nullptr, &m.light_down_switch, -1, 15}},
       {"light_step", {&m.light_step, nullptr, 0, 1}},

@@ -93,6 +93,12 @@ class Tab {
     if (!n->is_string()) fail(k, "expected a string");
     out = n->as_string()->get();
   }
+  void boolean(const std::string& k, bool& out) {
+    const toml::node* n = get(k);
+    if (!n) return;
+    if (!n->is_boolean()) fail(k, "expected true or false");
+    out = n->as_boolean()->get();
+  }
   std::string required_string(const std::string& k) {
     if (!has(k)) fail("", "missing key '" + k + "'");
     std::string s;
@@ -484,6 +490,24 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
       p.criteria = {s};
     });
     d.criteria.push_back(s);
+  }
+  if (auto t = root.table("view")) {
+    if (t->has("region_of_interest")) d.view.region_of_interest = t->location("region_of_interest");
+    std::string stain = core::to_string(d.view.gel_stain);
+    t->string("gel_stain", stain);
+    if (stain == "none") d.view.gel_stain = core::GelStain::kClear;
+    else if (stain == "triamcinolone") d.view.gel_stain = core::GelStain::kTriamcinolone;
+    else t->fail("gel_stain", "must be \"none\" or \"triamcinolone\"");
+    t->boolean("wide_angle", d.view.wide_angle);
+    t->boolean("chandelier", d.view.chandelier);
+    t->finish();
+    validated(*t, [&] {
+      core::SceneDescription probe;
+      probe.name = "probe";
+      probe.anatomy = d.anatomy;
+      probe.view = d.view;
+      probe.validate();
+    });
   }
   if (auto t = root.table("settle")) {
     t->integer("max_steps", d.settle.max_steps, 0, 20000);

@@ -53,6 +53,7 @@ struct PreparedCase {
   const CaseVisuals* visuals = nullptr;
   std::vector<ViewSnapshot> spare_views;
   std::size_t spare_views_used = 0;
+  double view_measured_at_s = -1e300;  // case time capture_view last measured the criteria for the picture
 };
 
 // The instrument kind of a scene file's instrument name; false for those that are not tracked

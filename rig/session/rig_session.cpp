@@ -5,6 +5,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <algorithm>
 #include <array>
@@ -108,6 +109,10 @@ telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
   in.n_values = 2;
   in.values[0] = static_cast<double>(static_cast<int>(cmd.code));
   in.values[1] = cmd.value;
+  if (cmd.code == telemetry::CommandCode::Pan) {  // y travels as text (validated by the server)
+    in.n_values = 3;
+    in.values[2] = std::strtod(cmd.arg, nullptr);
+  }
   return in;
 }
 
@@ -213,6 +218,8 @@ SessionSummary run_session(const SessionConfig& config) {
     ro.png_dir = config.png_dir;
     ro.png_every_frames = config.png_every_frames;
     ro.displays = config.displays;
+    ro.shm_ring_name = config.frame_ring_name;
+    ro.instructor_ring_name = config.instructor_ring_name;
     renderer = std::make_unique<render::RenderThread>(ro);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));

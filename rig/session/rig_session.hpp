@@ -49,6 +49,9 @@ struct SessionConfig {
   double display_hz = 30.0;
   std::string png_dir;
   std::uint64_t png_every_frames = 0;
+  // Shared-memory rings (rig/render/frame_ring.hpp) for a viewer or recorder: the stereo frames, and
+  // the instructor's view (the left eye with score, retina force and events over it); empty: none.
+  std::string frame_ring_name, instructor_ring_name;
   // The rig's displays (KMS scan-out, rig/render/kms_display.hpp); empty: headless.
   std::vector<vitreo::render::KmsOptions> displays;
   // Running scores on VITREO_SCORE every this many steps (and a final one at the end).

@@ -34,6 +34,9 @@ void SimulationModel::install(std::unique_ptr<PreparedCase> c) {
   eye_rotation_ = core::Quat::Identity();
   eye_tracked_ = false;
   paused_ = false;
+  // The microscope starts centred on the case's region of interest.
+  microscope_ = core::Microscope(config_.microscope, case_->scene->eye.fundus_coords(case_->focus_mm),
+                                 case_->scene->description.view.wide_angle);
   ++case_loads_;
 }
 
@@ -72,7 +75,12 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       case 5: ++resets_; break;        // Reset: requested here, the reload arrives as kCaseKind
       case 7: wireframe_ = !wireframe_; break;
       case 8: labels_ = !labels_; break;
-      case 9: zoom_override_ = in.values[1]; break;
+      case 9: microscope_.set_zoom(in.values[1]); break;
+      case 10: microscope_.pan_to(core::Vec2(in.values[1], in.n_values >= 3 ? in.values[2] : 0.0)); break;
+      case 11: microscope_.set_focus(in.values[1]); break;
+      case 12: flat_shading_ = !flat_shading_; break;
+      case 13: microscope_.toggle_wide_angle(); break;
+      case 14: microscope_.toggle_reinverter(); break;
       default: break;
     }
     ok = true;
@@ -104,7 +112,12 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       }
     }
   } else if (PedalReading p; decode_pedals(in, p)) {
+    const SurgicalControls before = pedals_.controls();
     ok = pedals_.apply(p);
+    // The pedal's zoom and focus are targets for the microscope's motors when they move (a command
+    // holds until the pedal moves again).
+    if (ok && pedals_.controls().zoom != before.zoom) microscope_.set_zoom(pedals_.controls().zoom);
+    if (ok && pedals_.controls().focus_offset_mm != before.focus_offset_mm) microscope_.set_focus(pedals_.controls().focus_offset_mm);
   } else if (DecodedEyeball e; decode_eyeball(in, e)) {
     const double n = e.orientation.coeffs().norm();
     if (std::abs(n - 1.0) < 1e-3) {
@@ -155,6 +168,7 @@ core::StepReport SimulationModel::step() {
     (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
   sys.set_air_infusion(c.air_infusion);
+  microscope_.step(config_.dt_s, core::MicroscopeInput{core::Vec2(c.pan_x, c.pan_y)});
   sys.set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
   // The case's metrics observe the step as its last stage, so a replay measures the same session.
@@ -169,8 +183,8 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_u64(steps_);
   h.add_u64(applied_);
   h.add_u64(resets_);
-  h.add_u64((paused_ ? 1u : 0u) | (wireframe_ ? 2u : 0u) | (labels_ ? 4u : 0u));
-  h.add_double(zoom_override_);
+  h.add_u64((paused_ ? 1u : 0u) | (wireframe_ ? 2u : 0u) | (labels_ ? 4u : 0u) | (flat_shading_ ? 8u : 0u));
+  microscope_.hash_into(h);
   h.add_u64(refused_);
   for (const auto& slot : instruments_) {
     h.add_u64((slot.present ? 1u : 0u) | (slot.frozen ? 2u : 0u) | (slot.pose.inserted ? 4u : 0u));
@@ -183,6 +197,9 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.vacuum_mmhg);
   h.add_double(c.cut_rate_cpm);
   h.add_double(c.zoom);
+  h.add_double(c.focus_offset_mm);
+  h.add_double(c.pan_x);
+  h.add_double(c.pan_y);
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
   h.add_u64(c.air_infusion ? 1u : 0u);

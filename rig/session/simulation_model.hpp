@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/sim/simulation.hpp"
+#include "core/scene/microscope.hpp"
 #include "rig/input/controls.hpp"
 #include "rig/input/port_pivot.hpp"
 #include "rig/scene_io/case_loader.hpp"
@@ -48,6 +49,7 @@ struct ModelConfig {
   double dt_s = 1e-3;
   PedalMapping pedals;
   TrackerCalibration calibration;
+  core::MicroscopeSettings microscope;
 };
 
 // The case list and overrides as one text (stored in a recording's header), and back. decode throws
@@ -84,10 +86,12 @@ class SimulationModel {
   // included (skipped while paused). Returns the tissue's report.
   core::StepReport step();
   bool paused() const { return paused_; }
-  // View state the operator sets (wireframe and labels toggles, microscope zoom override).
+  // View state the operator sets: wireframe, labels (the case's guides and the structures' names,
+  // shown at the start) and flat shading toggles; the microscope (pedal and commands drive it).
   bool wireframe() const { return wireframe_; }
   bool labels() const { return labels_; }
-  double zoom_override() const { return zoom_override_; }
+  bool flat_shading() const { return flat_shading_; }
+  const core::Microscope& microscope() const { return microscope_; }
   std::uint64_t resets() const { return resets_; }
 
   core::TissueWorld& world() { return case_->scene->world; }
@@ -125,8 +129,8 @@ class SimulationModel {
   std::array<InstrumentSlot, 4> instruments_{};
   core::Quat eye_rotation_ = core::Quat::Identity();
   bool paused_ = false;
-  bool wireframe_ = false, labels_ = false;
-  double zoom_override_ = 0.0;  // 0: the pedal's zoom
+  bool wireframe_ = false, labels_ = true, flat_shading_ = false;
+  core::Microscope microscope_{core::MicroscopeSettings{}, core::Vec2::Zero()};
   std::uint64_t applied_ = 0, refused_ = 0, steps_ = 0, resets_ = 0;
 };
 

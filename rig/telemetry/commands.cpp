@@ -24,6 +24,11 @@ const char* command_name(std::int8_t code) noexcept {
     case CommandCode::ToggleWireframe: return "toggle_wireframe";
     case CommandCode::ToggleLabels: return "toggle_labels";
     case CommandCode::Zoom: return "zoom";
+    case CommandCode::Pan: return "pan";
+    case CommandCode::Focus: return "focus";
+    case CommandCode::ToggleShading: return "toggle_shading";
+    case CommandCode::ToggleWideAngle: return "toggle_wide_angle";
+    case CommandCode::ToggleReinverter: return "toggle_reinverter";
   }
   return "unknown";
 }
@@ -99,18 +104,41 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
       c.arg = arg;
       out.ok = true;
     }
-  } else if (word == "z" || word == "zoom") {
+  } else if (word == "z" || word == "zoom" || word == "focus") {
     char* end = nullptr;
     const double v = arg.empty() ? 0.0 : std::strtod(arg.c_str(), &end);
     if (arg.empty() || end == arg.c_str() || *end != '\0' || !std::isfinite(v)) {
-      out.error = "zoom needs a finite number, e.g. 'zoom 12.5'";
+      out.error = word == "focus" ? "focus needs a finite number (mm), e.g. 'focus 0.8'" : "zoom needs a finite number, e.g. 'zoom 12.5'";
     } else {
-      c.command = static_cast<std::int8_t>(CommandCode::Zoom);
+      c.command = static_cast<std::int8_t>(word == "focus" ? CommandCode::Focus : CommandCode::Zoom);
       c.value = v;
       out.ok = true;
     }
+  } else if (word == "pan") {
+    // Two numbers: x into `value`, y kept as text in `arg` (the message has one number field).
+    char* end = nullptr;
+    const double x = std::strtod(arg.c_str(), &end);
+    const char* rest = end;
+    char* end_y = nullptr;
+    const double y = arg.empty() ? 0.0 : std::strtod(rest, &end_y);
+    if (arg.empty() || end == arg.c_str() || end_y == rest || *end_y != '\0') {
+      out.error = "pan needs two numbers (mm from the region of interest), e.g. 'pan 1.5 -2'";
+    } else {
+      c.command = static_cast<std::int8_t>(CommandCode::Pan);
+      c.value = x;
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.17g", y);
+      c.arg = buf;
+      out.ok = true;
+    }
+  } else if (word == "flat") {
+    simple(CommandCode::ToggleShading);
+  } else if (word == "wide") {
+    simple(CommandCode::ToggleWideAngle);
+  } else if (word == "invert") {
+    simple(CommandCode::ToggleReinverter);
   } else {
-    out.error = "unknown command '" + word + "' (n, p, pause, resume, r, s NAME, w, l, z X)";
+    out.error = "unknown command '" + word + "' (n, p, pause, resume, r, s NAME, w, l, z X, pan X Y, focus F, flat, wide, invert)";
   }
   return out;
 }
@@ -126,6 +154,19 @@ Verdict check_command(const vitreo_lcm::operator_command_t& cmd, const CommandLi
       if (cmd.value < limits.zoom_min || cmd.value > limits.zoom_max)
         return refuse(fmt::format("zoom {:g} outside the rig's range {:g}..{:g}", cmd.value, limits.zoom_min, limits.zoom_max));
       break;
+    case CommandCode::Focus:
+      if (!std::isfinite(cmd.value) || std::abs(cmd.value) > 0.5 * limits.focus_range_mm)
+        return refuse(fmt::format("focus {:g} mm outside the rig's range ±{:g} mm", cmd.value, 0.5 * limits.focus_range_mm));
+      break;
+    case CommandCode::Pan: {
+      char* end = nullptr;
+      const double y = std::strtod(cmd.arg.c_str(), &end);
+      if (cmd.arg.empty() || *end != '\0' || !std::isfinite(y) || !std::isfinite(cmd.value))
+        return refuse("pan needs x (value) and y (arg) as finite numbers of mm");
+      if (std::abs(cmd.value) > limits.pan_range_mm || std::abs(y) > limits.pan_range_mm)
+        return refuse(fmt::format("pan {:g} {:g} mm outside the rig's range ±{:g} mm", cmd.value, y, limits.pan_range_mm));
+      break;
+    }
     case CommandCode::NextCase:
     case CommandCode::PreviousCase:
     case CommandCode::Pause:
@@ -133,6 +174,9 @@ Verdict check_command(const vitreo_lcm::operator_command_t& cmd, const CommandLi
     case CommandCode::Reset:
     case CommandCode::ToggleWireframe:
     case CommandCode::ToggleLabels:
+    case CommandCode::ToggleShading:
+    case CommandCode::ToggleWideAngle:
+    case CommandCode::ToggleReinverter:
       break;
     default:
       return refuse("unknown command code " + std::to_string(cmd.command));

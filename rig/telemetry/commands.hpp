@@ -35,6 +35,11 @@ enum class CommandCode : std::int8_t {
   ToggleWireframe = 7,
   ToggleLabels = 8,
   Zoom = 9,
+  Pan = 10,                // value = x, arg = y (mm, fundus plane) from the case's region of interest
+  Focus = 11,              // value = focal plane offset from the fundus (mm, + toward the microscope)
+  ToggleShading = 12,      // flat / smooth shading of the tissue (the thesis' F2)
+  ToggleWideAngle = 13,    // the wide-angle viewing system in / out
+  ToggleReinverter = 14,   // the wide-angle image re-inverter on / off
 };
 const char* command_name(std::int8_t code) noexcept;
 
@@ -42,6 +47,8 @@ const char* command_name(std::int8_t code) noexcept;
 struct CommandLimits {
   double zoom_min = 1.0;  // microscope magnification range of the rig
   double zoom_max = 25.0;
+  double pan_range_mm = 20.0;    // |x|, |y| of a pan from the region of interest
+  double focus_range_mm = 6.0;   // focus within ±half of this
 };
 
 // The session's state a command is decided against, as physics sees it at that moment.
@@ -75,7 +82,7 @@ bool valid_snapshot_name(const std::string& s);
 // The terminal's spelling of the commands (thesis ch. 2.6.1 keys, plus words), one per line:
 //   n | next            p | prev | previous        space | pause     resume
 //   r | reset           s NAME | save NAME          w | wireframe    l | labels
-//   z X | zoom X
+//   z X | zoom X        pan X Y            focus F        flat        wide        invert
 // Returns the command (utime_us/source/seq filled from the arguments) or an error message. The
 // syntax is checked here (a snapshot name too: it is never shortened to fit), the rest by the rig,
 // which answers with an ack.

@@ -126,6 +126,25 @@ TEST(Pedals, MicroscopePedalZoomsFocusesAndStepsTheLight) {
   EXPECT_DOUBLE_EQ(m.controls().zoom, 4.0);
   EXPECT_DOUBLE_EQ(m.controls().focus_offset_mm, -1.5);
   EXPECT_NEAR(m.controls().light_level, 0.8, 1e-12);
+  EXPECT_EQ(m.controls().pan_x, 0.0) << "a pedal without joystick axes leaves the field still";
+  EXPECT_EQ(m.controls().pan_y, 0.0);
+}
+
+TEST(Pedals, MicroscopeJoystickHasADeadBandAndFullDeflection) {
+  rig::PedalMapper m;
+  rig::PedalReading r;
+  r.pedal_id = 1;
+  r.axis_count = 4;
+  r.axes[0] = 0.0;
+  r.axes[1] = 0.5;
+  r.axes[2] = 0.52;  // inside the dead band (0.08 of the half travel)
+  r.axes[3] = 0.0;   // full deflection down
+  ASSERT_TRUE(m.apply(r));
+  EXPECT_EQ(m.controls().pan_x, 0.0);
+  EXPECT_DOUBLE_EQ(m.controls().pan_y, -1.0);
+  r.axes[2] = 0.77;  // half way between the dead band's edge (0.54) and the end
+  ASSERT_TRUE(m.apply(r));
+  EXPECT_NEAR(m.controls().pan_x, 0.5, 1e-12);
 }
 
 TEST(Pedals, ABrokenPedalCannotOpenTheVacuum) {

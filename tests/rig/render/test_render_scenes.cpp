@@ -10,6 +10,7 @@
 #include <fstream>
 #include <memory>
 
+#include "render_fixture.hpp"
 #include "synthetic_scene.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/image_compare.hpp"
@@ -56,19 +57,8 @@ Rgb patch(const vr::Image& img, vr::Vec2 p, int k = 1) {
   return s;
 }
 
-class RenderScenes : public ::testing::Test {
+class RenderScenes : public vt::RendererFixture<kW, kH> {
  protected:
-  void SetUp() override {
-    vr::EglOptions o;
-    o.honour_environment = false;
-    context_ = std::make_unique<vr::EglContext>(o);
-    renderer_ = std::make_unique<vr::StereoRenderer>(vr::RenderSettings{kW, kH, 512, 512});
-  }
-  vr::StereoFrame render(const vr::FrameScene& s) {
-    vr::StereoFrame f;
-    renderer_->render(s, f);
-    return f;
-  }
   static vr::Mesh* mesh(vr::FrameScene& s, std::uint32_t id) {
     for (auto& m : s.meshes)
       if (m.id == id) return &m;
@@ -97,9 +87,6 @@ class RenderScenes : public ::testing::Test {
                     << " (limits rmse<=2.5, over(24)<=1%); actual written to " << out;
     }
   }
-
-  std::unique_ptr<vr::EglContext> context_;
-  std::unique_ptr<vr::StereoRenderer> renderer_;
 };
 
 vr::FrameScene burn_scene() {

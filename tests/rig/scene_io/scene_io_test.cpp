@@ -171,6 +171,25 @@ TEST(CaseLoader, SecondLoadComesFromTheCacheWithTheSameState) {
   std::filesystem::remove_all(dir);
 }
 
+// The [view] table: what the rig's microscope and renderer read, and its defaults when absent.
+TEST(SceneFiles, ViewTableIsReadWithItsDefaults) {
+  const core::SceneDescription plain = scene_io::parse_scene("format_version = 1\nname = \"v\"\n", "plain.toml");
+  EXPECT_FALSE(plain.view.region_of_interest.has_value());
+  EXPECT_EQ(plain.view.gel_stain, core::GelStain::kClear);
+  EXPECT_FALSE(plain.view.wide_angle);
+  EXPECT_FALSE(plain.view.chandelier);
+  const core::SceneDescription v = scene_io::parse_scene(
+      "format_version = 1\nname = \"v\"\n[view]\nregion_of_interest = { polar_deg = 55.5, azimuth_deg = 200 }\n"
+      "gel_stain = \"triamcinolone\"\nwide_angle = true\nchandelier = true\n",
+      "view.toml");
+  ASSERT_TRUE(v.view.region_of_interest.has_value());
+  EXPECT_EQ(v.view.region_of_interest->polar_deg, 55.5);
+  EXPECT_EQ(v.view.region_of_interest->azimuth_deg, 200.0);
+  EXPECT_EQ(v.view.gel_stain, core::GelStain::kTriamcinolone);
+  EXPECT_TRUE(v.view.wide_angle);
+  EXPECT_TRUE(v.view.chandelier);
+}
+
 TEST(SceneFiles, MissingFileIsAnError) {
   EXPECT_THROW(scene_io::load_scene_file("/nonexistent/case.toml"), scene_io::SceneError);
 }

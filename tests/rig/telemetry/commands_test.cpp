@@ -62,6 +62,20 @@ TEST(CommandValidation, AcceptsValidCommandsAndRefusesBadOnesWithAReason) {
   EXPECT_FALSE(validate_command(make(Cmd::ZOOM, 1, std::nan("")), ctx).accepted);
   EXPECT_FALSE(validate_command(make(Cmd::ZOOM, 1, std::numeric_limits<double>::infinity()), ctx).accepted);
 
+  EXPECT_TRUE(validate_command(make(Cmd::PAN, 1, 1.5, "-2"), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::PAN, 1, -20.0, "20"), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::PAN, 1, 21.0, "0"), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::PAN, 1, 0.0, "-21"), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::PAN, 1, 0.0, ""), ctx).accepted) << "y is required";
+  EXPECT_FALSE(validate_command(make(Cmd::PAN, 1, 0.0, "2mm"), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::PAN, 1, std::nan(""), "0"), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::FOCUS, 1, 3.0), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::FOCUS, 1, -3.5), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::FOCUS, 1, std::nan("")), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_SHADING), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_WIDE_ANGLE), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_REINVERTER), ctx).accepted);
+
   EXPECT_TRUE(validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, "before-peel_2.v1"), ctx).accepted);
   for (const char* bad : {"", "../etc/passwd", "a/b", ".hidden", "spa ce", "x\n"}) {
     const Verdict v = validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, bad), ctx);
@@ -209,7 +223,10 @@ TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
                         Case{"resume", Cmd::RESUME, 0, ""}, Case{"  r  ", Cmd::RESET, 0, ""},
                         Case{"w", Cmd::TOGGLE_WIREFRAME, 0, ""}, Case{"labels", Cmd::TOGGLE_LABELS, 0, ""},
                         Case{"s before-peel", Cmd::SAVE_SNAPSHOT, 0, "before-peel"},
-                        Case{"zoom 12.5", Cmd::ZOOM, 12.5, ""}, Case{"z 8\n", Cmd::ZOOM, 8, ""}}) {
+                        Case{"zoom 12.5", Cmd::ZOOM, 12.5, ""}, Case{"z 8\n", Cmd::ZOOM, 8, ""},
+                        Case{"pan 1.5 -2", Cmd::PAN, 1.5, "-2"}, Case{"focus -0.75", Cmd::FOCUS, -0.75, ""},
+                        Case{"flat", Cmd::TOGGLE_SHADING, 0, ""}, Case{"wide", Cmd::TOGGLE_WIDE_ANGLE, 0, ""},
+                        Case{"invert", Cmd::TOGGLE_REINVERTER, 0, ""}}) {
     const ParsedCommand p = parse_command_line(k.line, "terminal", 7);
     ASSERT_TRUE(p.ok) << "'" << k.line << "': " << p.error;
     EXPECT_EQ(p.command.command, k.code) << k.line;
@@ -221,7 +238,8 @@ TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
   // A snapshot name is checked whole: 70 characters were cut to 64 and accepted on the terminal.
   for (const char* bad : {"", "   ", "zoom", "zoom x", "zoom 3x", "save", "n 3", "fly",
                           "s aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa", "s ../x", "s .hidden",
-                          "zoom nan", "zoom inf", "z -inf", "zoom 1e999"}) {
+                          "zoom nan", "zoom inf", "z -inf", "zoom 1e999", "pan", "pan 1", "pan 1 x",
+                          "pan 1 2 3", "focus", "focus far", "wide 2", "focus nan"}) {
     const ParsedCommand p = parse_command_line(bad, "terminal", 1);
     EXPECT_FALSE(p.ok) << "'" << bad << "' parsed";
     EXPECT_FALSE(p.error.empty());

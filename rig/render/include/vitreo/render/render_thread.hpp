@@ -29,6 +29,10 @@ struct RenderThreadOptions {
   RenderSettings render;
   std::string shm_ring_name;  // empty: no shared-memory ring
   int shm_ring_slots = 3;
+  /// The instructor's view (instructor_view.hpp): the left eye with the scene's InstructorOverlay,
+  /// into its own one-picture ring (empty: none) and, with png_dir, beside each PNG series as
+  /// <prefix>_instructor.png. Scenes without an overlay show the plain left eye there.
+  std::string instructor_ring_name;
   /// Stereo frames of a run as PNGs (issue 8: "a few along the way and the last one"): when set, every
   /// png_every_frames-th rendered frame (0: none along the way) and the last frame rendered before
   /// stop() are written to <png_dir>/step_<step>_{left,right,stereo}.png. The directory must exist.
