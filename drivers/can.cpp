@@ -104,6 +104,10 @@ CanDevice::CanDevice(std::string ifname, std::uint8_t node_id, bool use_fd, Cloc
   });
 }
 
+std::string CanDevice::uri() const {
+  return "can:" + ifname_ + "?node=" + std::to_string(node_) + (use_fd_ ? "&fd=1" : "");
+}
+
 void CanDevice::try_open(std::uint64_t now_us) {
   if (opened_once_) session_.reconnect_attempt(now_us);
   opened_once_ = true;

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "drivers/device.hpp"
 #include "drivers/session.hpp"
 #include "firmware-protocol/vp.hpp"
 
@@ -56,11 +57,14 @@ struct CanLinkStats {
 
 // The driver for one device (node id) on a CAN interface. use_fd: host messages as CAN FD frames;
 // the device's frames are accepted in either form.
-class CanDevice {
+class CanDevice final : public Device {
  public:
   CanDevice(std::string ifname, std::uint8_t node_id, bool use_fd, Clock& clock, SessionConfig cfg = {});
-  void poll(int timeout_ms);
-  DeviceSession& session() { return session_; }
+  Transport transport() const override { return Transport::can; }
+  std::string uri() const override;
+  void poll(int timeout_ms) override;
+  DeviceSession& session() override { return session_; }
+  const DeviceSession& session() const override { return session_; }
   const CanLinkStats& can_stats() const { return can_stats_; }
   void set_raw_tap(std::function<void(const CanRxFrame&)> f) { raw_tap_ = std::move(f); }
 

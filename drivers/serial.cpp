@@ -120,6 +120,10 @@ SerialDevice::SerialDevice(std::string path, Clock& clock, SessionConfig cfg, in
   });
 }
 
+std::string SerialDevice::uri() const {
+  return "serial:" + path_ + (baud_ != 921600 ? "?baud=" + std::to_string(baud_) : "");
+}
+
 void SerialDevice::try_open(std::uint64_t now_us) {
   std::string err;
   if (opened_once_) session_.reconnect_attempt(now_us);

@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 
+#include "drivers/device.hpp"
 #include "drivers/session.hpp"
 #include "firmware-protocol/vp.hpp"
 
@@ -37,14 +38,16 @@ class SerialPort {
 
 // Device driver over a serial port: frames → session; reopens the same path after a loss (a
 // /dev/serial/by-id link survives re-plugging, so the path is the device's identity).
-class SerialDevice {
+class SerialDevice final : public Device {
  public:
   SerialDevice(std::string path, Clock& clock, SessionConfig cfg = {}, int baud = 921600);
+  Transport transport() const override { return Transport::serial; }
+  std::string uri() const override;
   // Waits up to timeout_ms for input (0: do not wait), handles everything available, runs the
   // session's timeouts and, when lost, the reconnection attempts.
-  void poll(int timeout_ms);
-  DeviceSession& session() { return session_; }
-  const DeviceSession& session() const { return session_; }
+  void poll(int timeout_ms) override;
+  DeviceSession& session() override { return session_; }
+  const DeviceSession& session() const override { return session_; }
   const std::string& path() const { return path_; }
   // Called with every chunk of raw bytes read (the tool's raw dump).
   void set_raw_tap(std::function<void(std::span<const std::uint8_t>)> f) { raw_tap_ = std::move(f); }

@@ -1,6 +1,7 @@
 #include "drivers/session.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 
 namespace vitreo::drivers {
@@ -24,17 +25,18 @@ const char* to_string(LinkState s) {
 }
 
 std::string to_string(const LinkStats& s) {
-  char b[512];
+  char b[640];
   std::snprintf(b, sizeof b,
                 "bytes=%llu frames=%llu valid=%llu crc=%llu framing=%llu version=%llu unknown=%llu length=%llu "
-                "range=%llu drops=%llu ts_jumps=%llu stuck=%llu delivered=%llu disconnects=%llu reconnects=%llu "
+                "range=%llu drops=%llu ts_jumps=%llu stuck=%llu stuck_episodes=%llu identity=%llu delivered=%llu disconnects=%llu reconnects=%llu "
                 "latency_us(last/mean/max)=%llu/%.0f/%llu",
                 (unsigned long long)s.bytes, (unsigned long long)s.frames, (unsigned long long)s.valid,
                 (unsigned long long)s.crc_errors, (unsigned long long)s.framing_errors,
                 (unsigned long long)s.version_errors, (unsigned long long)s.unknown_type,
                 (unsigned long long)s.length_errors, (unsigned long long)s.range_rejected,
                 (unsigned long long)s.drops, (unsigned long long)s.timestamp_jumps,
-                (unsigned long long)s.stuck_samples, (unsigned long long)s.samples_delivered,
+                (unsigned long long)s.stuck_samples, (unsigned long long)s.stuck_episodes, (unsigned long long)s.identity_rejected,
+                (unsigned long long)s.samples_delivered,
                 (unsigned long long)s.disconnects, (unsigned long long)s.reconnects,
                 (unsigned long long)s.latency_last_us, s.latency_mean_us, (unsigned long long)s.latency_max_us);
   return b;
@@ -129,13 +131,16 @@ void DeviceSession::send_configure(std::uint64_t now_us) {
 }
 
 void DeviceSession::transport_up(std::uint64_t now_us) {
-  if (state_ == LinkState::reconnecting || stats_.disconnects > 0) ++stats_.reconnects;
+  // a reconnect is counted when the device identifies itself on the re-opened transport: re-opening
+  // a CAN socket or a pty link succeeds whether or not the device is there
+  recovering_ = state_ == LinkState::reconnecting || stats_.disconnects > 0;
   have_info_ = false;
   configured_ = false;
   last_seq_ = -1;
   have_device_us_ = false;
   last_host_us_ = 0;
-  same_count_ = 0;
+  last_payload_.clear();
+  stuck_ = false;
   clock_.reset();
   last_frame_us_ = now_us;
   set_state(LinkState::connecting, now_us, "transport open");
@@ -197,8 +202,22 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
         last_error_ = "device announces an unsupported protocol major version";
         return;
       }
+      if ((cfg_.expected_device_type != 0 && m.u.device_info.device_type != cfg_.expected_device_type) ||
+          (cfg_.expected_serial != 0 && m.u.device_info.serial != cfg_.expected_serial)) {
+        ++stats_.identity_rejected;
+        char why[128];
+        std::snprintf(why, sizeof why, "device is type %u serial %u, expected type %u serial %u (0 = any)",
+                      static_cast<unsigned>(m.u.device_info.device_type), static_cast<unsigned>(m.u.device_info.serial),
+                      static_cast<unsigned>(cfg_.expected_device_type), static_cast<unsigned>(cfg_.expected_serial));
+        last_error_ = why;
+        return;
+      }
       info_ = m.u.device_info;
       have_info_ = true;
+      if (recovering_) {
+        ++stats_.reconnects;
+        recovering_ = false;
+      }
       if (state_ == LinkState::connecting) {
         set_state(LinkState::configuring, now_us, "device identified");
         send_configure(now_us);
@@ -227,20 +246,12 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       for (int i = 0; i < 4; ++i) s.q_wxyz[i] = p.q_wxyz[i];
       s.actuation = p.actuation / 65535.0f;
       s.quality = p.quality_pct / 100.0f;
-      // a real tracker's floats always jitter; a long run of bit-identical poses is a frozen sensor
+      // a real tracker's floats always jitter; bit-identical poses for 50 ms are a frozen sensor
       std::uint8_t key[30];
       std::memcpy(key, p.tip_mm, 12);
       std::memcpy(key + 12, p.q_wxyz, 16);
       std::memcpy(key + 28, &p.actuation, 2);
-      if (last_payload_.size() == sizeof key && std::memcmp(last_payload_.data(), key, sizeof key) == 0) {
-        if (++same_count_ >= cfg_.stuck_after) {
-          s.stuck = true;
-          ++stats_.stuck_samples;
-        }
-      } else {
-        same_count_ = 0;
-        last_payload_.assign(key, key + sizeof key);
-      }
+      s.stuck = check_stuck(key, sizeof key, p.timestamp_us);
       deliver(s, p.timestamp_us, now_us);
       return;
     }
@@ -263,6 +274,10 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
         s.inserted[i] = p.ports[i].flags & 1u;
         s.depth_mm[i] = p.ports[i].depth_mm;
       }
+      std::uint8_t key[32];
+      std::memcpy(key, p.q_wxyz, 16);
+      for (int i = 0; i < 4; ++i) std::memcpy(key + 16 + 4 * i, &p.ports[i].depth_mm, 4);
+      s.stuck = check_stuck(key, sizeof key, p.timestamp_us);
       deliver(s, p.timestamp_us, now_us);
       return;
     }
@@ -270,6 +285,25 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       if (on_message_) on_message_(m);
       return;
   }
+}
+
+bool DeviceSession::check_stuck(const void* payload, std::size_t size, std::uint64_t device_us) {
+  // Samples before streaming are not delivered; a timestamp that goes back starts afresh.
+  const bool same = last_payload_.size() == size && std::memcmp(last_payload_.data(), payload, size) == 0 &&
+                    device_us >= same_since_device_us_;
+  if (!same) {
+    const auto* b = static_cast<const std::uint8_t*>(payload);
+    last_payload_.assign(b, b + size);
+    same_since_device_us_ = device_us;
+    stuck_ = false;
+    return false;
+  }
+  if (device_us - same_since_device_us_ >= cfg_.stuck_after_us) {
+    if (!stuck_) ++stats_.stuck_episodes;
+    stuck_ = true;
+    ++stats_.stuck_samples;
+  }
+  return stuck_;
 }
 
 bool DeviceSession::request_calibration(std::uint8_t procedure, std::uint8_t instrument_id, std::uint16_t token) {

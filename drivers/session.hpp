@@ -52,7 +52,7 @@ struct PoseSample {
   std::array<float, 4> q_wxyz{1, 0, 0, 0};
   float actuation = 0;  // 0..1
   float quality = 0;    // 0..1
-  bool stuck = false;   // identical to a long run of previous samples (frozen sensor suspected)
+  bool stuck = false;   // bit-identical to every sample of the last >= stuck_after_us of device time
 };
 struct PedalSample {
   SampleTime t;
@@ -68,7 +68,7 @@ struct EyeballSample {
   std::uint8_t port_count = 0;
   std::array<bool, 4> inserted{};
   std::array<float, 4> depth_mm{};
-  bool stuck = false;
+  bool stuck = false;  // as for poses: the fixture's orientation and port depths frozen
 };
 using Sample = std::variant<PoseSample, PedalSample, EyeballSample>;
 
@@ -87,10 +87,12 @@ struct LinkStats {
   std::uint64_t range_rejected = 0;   // NaN/inf/out-of-range fields
   std::uint64_t drops = 0;            // frames missing according to the sequence counter
   std::uint64_t timestamp_jumps = 0;  // device clock stepped backwards or far forwards
-  std::uint64_t stuck_samples = 0;
+  std::uint64_t stuck_samples = 0;   // samples delivered while stuck
+  std::uint64_t stuck_episodes = 0;  // times the sensor became stuck
+  std::uint64_t identity_rejected = 0;  // DEVICE_INFO of another kind or serial than the rig expects
   std::uint64_t samples_delivered = 0;
   std::uint64_t disconnects = 0;
-  std::uint64_t reconnects = 0;
+  std::uint64_t reconnects = 0;       // the device identified itself again after a loss
   std::uint64_t latency_count = 0;
   std::uint64_t latency_last_us = 0;
   std::uint64_t latency_max_us = 0;
@@ -133,7 +135,14 @@ struct SessionConfig {
   std::uint64_t time_sync_interval_us = 1'000'000;
   std::uint64_t jump_tolerance_us = 100'000;   // device timestamp step counted as a jump
   std::uint16_t sample_rate_hz = 1000;
-  std::uint32_t stuck_after = 200;             // identical consecutive samples before "stuck"
+  // A pose (tracker) or orientation (eyeball fixture) bit-identical for this long of the device's
+  // own time is a frozen sensor: a real one always jitters. Samples whose timestamps do not advance
+  // are repeats, not evidence. Pedals at rest legitimately repeat, so they are not checked.
+  std::uint64_t stuck_after_us = 50'000;
+  // Identity the rig expects at this address (0: any). A device announcing another kind or serial
+  // is not configured: the wrong tracker plugged into the tracker's port must not drive the forceps.
+  std::uint8_t expected_device_type = 0;       // vp_device_type
+  std::uint32_t expected_serial = 0;
 };
 
 class DeviceSession {
@@ -167,6 +176,8 @@ class DeviceSession {
   const LinkStats& stats() const { return stats_; }
   const vp_device_info& device_info() const { return info_; }
   bool has_device_info() const { return have_info_; }
+  // The sensor is stuck now (its last sample was flagged).
+  bool stuck() const { return stuck_; }
   const ClockMapper& clock() const { return clock_; }
   const SessionConfig& config() const { return cfg_; }
   std::uint64_t next_reconnect_us() const { return next_reconnect_us_; }
@@ -191,6 +202,7 @@ class DeviceSession {
   vp_device_info info_{};
   bool have_info_ = false;
   bool configured_ = false;
+  bool recovering_ = false;  // the transport was re-opened after a loss; the device not identified yet
   ClockMapper clock_;
   std::uint64_t last_frame_us_ = 0, last_sample_us_ = 0, state_since_us_ = 0;
   std::uint64_t next_retry_us_ = 0, next_sync_us_ = 0, next_reconnect_us_ = 0;
@@ -199,8 +211,11 @@ class DeviceSession {
   int last_seq_ = -1;
   std::uint8_t tx_seq_ = 0, sync_exchange_ = 0;
   std::uint64_t sync_tx_us_ = 0;
+  // Stuck detection: the payload of the current run of identical samples and where it began.
+  bool check_stuck(const void* payload, std::size_t size, std::uint64_t device_us);
   std::vector<std::uint8_t> last_payload_;
-  std::uint32_t same_count_ = 0;
+  std::uint64_t same_since_device_us_ = 0;
+  bool stuck_ = false;
   std::string last_error_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <libusb.h>
 
+#include <cstdio>
 #include <cstring>
 
 #include "firmware-protocol/vp.hpp"
@@ -46,8 +47,8 @@ bool list_usb_devices(std::vector<UsbDeviceEntry>& out, std::string* error) {
   return true;
 }
 
-UsbDevice::UsbDevice(std::uint16_t vid, std::uint16_t pid, Clock& clock, SessionConfig cfg)
-    : vid_(vid), pid_(pid), clock_(clock), session_(cfg) {
+UsbDevice::UsbDevice(std::uint16_t vid, std::uint16_t pid, Clock& clock, SessionConfig cfg, std::string serial_number)
+    : vid_(vid), pid_(pid), serial_number_(std::move(serial_number)), clock_(clock), session_(cfg) {
   session_.set_send([this](const vp_message& m) { send(m); });
 }
 
@@ -104,11 +105,13 @@ void UsbDevice::on_in(libusb_transfer* t) {
       vp_message m{};
       int st = vp_usb_decode(bytes.data(), bytes.size(), &m);
       d->session_.on_frame(st, m, now);
+      if (d->closing_) break;  // completed just before the cancel: not resubmitted
       if (!d->gone_ && libusb_submit_transfer(t) == 0) return;
       d->gone_ = true;
       break;
     }
     case LIBUSB_TRANSFER_TIMED_OUT:
+      if (d->closing_) break;
       if (!d->gone_ && libusb_submit_transfer(t) == 0) return;
       d->gone_ = true;
       break;
@@ -147,13 +150,44 @@ void UsbDevice::send(const vp_message& m) {
   }
 }
 
+std::string UsbDevice::uri() const {
+  char ids[16];
+  std::snprintf(ids, sizeof ids, "%04x:%04x", vid_, pid_);
+  return std::string("usb:") + ids + (serial_number_.empty() ? "" : "/" + serial_number_);
+}
+
+libusb_device_handle* UsbDevice::open_matching() {
+  libusb_device** list = nullptr;
+  const ssize_t n = libusb_get_device_list(ctx_, &list);
+  libusb_device_handle* found = nullptr;
+  for (ssize_t i = 0; i < n && !found; ++i) {
+    libusb_device_descriptor d{};
+    if (libusb_get_device_descriptor(list[i], &d) != 0 || d.idVendor != vid_ || d.idProduct != pid_) continue;
+    libusb_device_handle* h = nullptr;
+    if (libusb_open(list[i], &h) != 0) continue;
+    if (!serial_number_.empty()) {
+      // the serial number string tells two devices of one kind apart; a device without one, or
+      // with another, is not ours
+      unsigned char s[128] = {};
+      const int len = d.iSerialNumber ? libusb_get_string_descriptor_ascii(h, d.iSerialNumber, s, sizeof s - 1) : -1;
+      if (len <= 0 || serial_number_ != std::string(reinterpret_cast<char*>(s), static_cast<std::size_t>(len))) {
+        libusb_close(h);
+        continue;
+      }
+    }
+    found = h;
+  }
+  if (n >= 0) libusb_free_device_list(list, 1);
+  return found;
+}
+
 bool UsbDevice::try_open(std::uint64_t now_us) {
   if (opened_once_) session_.reconnect_attempt(now_us);
   opened_once_ = true;
   arrived_ = false;
-  libusb_device_handle* h = libusb_open_device_with_vid_pid(ctx_, vid_, pid_);
+  libusb_device_handle* h = open_matching();
   if (!h) {
-    session_.transport_down(now_us, "no such USB device");
+    session_.transport_down(now_us, serial_number_.empty() ? "no such USB device" : "no USB device with this serial number");
     return false;
   }
   if (libusb_claim_interface(h, 0) != 0) {
@@ -182,12 +216,20 @@ bool UsbDevice::try_open(std::uint64_t now_us) {
 
 void UsbDevice::close_handle() {
   if (!h_) return;
+  // No callback may resubmit from here on: a transfer that completes between the cancel and its
+  // callback would otherwise go back in flight and be freed under libusb's feet.
+  closing_ = true;
   for (auto* t : in_) libusb_cancel_transfer(t);  // errors for completed ones are harmless
   timeval tv{0, 2000};
-  for (int i = 0; i < 500 && outstanding_ > 0; ++i) libusb_handle_events_timeout_completed(ctx_, &tv, nullptr);
-  for (auto* t : in_) libusb_free_transfer(t);
+  for (int i = 0; i < 2500 && outstanding_ > 0; ++i) libusb_handle_events_timeout_completed(ctx_, &tv, nullptr);
+  // A transfer still in flight after 5 s (a wedged host controller) is leaked, never freed while
+  // libusb may still touch it.
+  if (outstanding_ == 0) {
+    for (auto* t : in_) libusb_free_transfer(t);
+  }
   in_.clear();
   outstanding_ = 0;
+  closing_ = false;
   libusb_release_interface(h_, 0);
   libusb_close(h_);
   h_ = nullptr;

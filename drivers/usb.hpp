@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/device.hpp"
 #include "drivers/session.hpp"
 
 struct libusb_context;
@@ -28,19 +29,22 @@ struct UsbDeviceEntry {
 // Lists vitreo devices (our VID) currently present; false with a reason on libusb failure.
 bool list_usb_devices(std::vector<UsbDeviceEntry>& out, std::string* error);
 
-class UsbDevice {
+// The driver for one device, found by vendor and product id and, when given, its serial number
+// string (descriptor 3): after a re-plug the device is looked up again by those, so it is found
+// whatever bus address it comes back at, and a second device of the same kind is never taken for it.
+class UsbDevice final : public Device {
  public:
-  UsbDevice(std::uint16_t vid, std::uint16_t pid, Clock& clock, SessionConfig cfg = {});
-  ~UsbDevice();
-  UsbDevice(const UsbDevice&) = delete;
-  UsbDevice& operator=(const UsbDevice&) = delete;
+  UsbDevice(std::uint16_t vid, std::uint16_t pid, Clock& clock, SessionConfig cfg = {}, std::string serial_number = {});
+  ~UsbDevice() override;
 
   // libusb context and hotplug registration; false with a reason.
   bool init(std::string* error);
+  Transport transport() const override { return Transport::usb; }
+  std::string uri() const override;
   // Handles USB events for up to timeout_ms, runs timeouts, reopens after a loss.
-  void poll(int timeout_ms);
-  DeviceSession& session() { return session_; }
-  const DeviceSession& session() const { return session_; }
+  void poll(int timeout_ms) override;
+  DeviceSession& session() override { return session_; }
+  const DeviceSession& session() const override { return session_; }
   void set_raw_tap(std::function<void(std::span<const std::uint8_t>)> f) { raw_tap_ = std::move(f); }
   std::uint64_t hotplug_arrivals() const { return arrivals_; }
   std::uint64_t hotplug_departures() const { return departures_; }
@@ -53,7 +57,10 @@ class UsbDevice {
   void close_handle();
   void send(const vp_message& m);
 
+  libusb_device_handle* open_matching();
+
   std::uint16_t vid_, pid_;
+  std::string serial_number_;
   Clock& clock_;
   DeviceSession session_;
   libusb_context* ctx_ = nullptr;
@@ -63,6 +70,7 @@ class UsbDevice {
   bool hotplug_ = false;
   int outstanding_ = 0;
   bool gone_ = false;        // a transfer reported the device gone: close at the next poll
+  bool closing_ = false;     // close_handle() is cancelling: callbacks do not resubmit
   bool arrived_ = false;     // hotplug says a matching device appeared: try at once
   bool opened_once_ = false;
   std::uint64_t arrivals_ = 0, departures_ = 0;

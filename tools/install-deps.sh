@@ -13,6 +13,8 @@ packages=(
   liblcm-dev liblcm-bin
   libusb-1.0-0-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libpng-dev
+  # recordings: the running CRC-32 of their checksum blocks
+  zlib1g-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   umockdev libumockdev-dev can-utils iproute2 util-linux

@@ -1,6 +1,7 @@
 #include "core/anatomy/fundus_texture.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -11,6 +12,10 @@ namespace vitreo::core {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// Vessel colours (linear 0..1): oxygenated arterial blood is a brighter red, venous blood darker
+// and bluer.
+constexpr double kArtery[3] = {0.74, 0.14, 0.10};
+constexpr double kVein[3] = {0.42, 0.05, 0.09};
 
 // splitmix64: tiny, portable, and the same bits everywhere (std distributions are not).
 class Rng {
@@ -60,6 +65,14 @@ double fractal(double x, double y, std::uint64_t seed) {
   return sum / 0.9375;
 }
 
+// The retinal vessel tree, grown as walks whose heading is steered toward a wanted direction plus
+// seeded wander. The layout follows fundus anatomy (e.g. Hogan & Feeney 1963; any atlas of the
+// fundus): four artery–vein pairs leave the optic disc; the superior and inferior temporal
+// arcades arch around the macula (passing ~4–6 mm above and below the fovea) and run on to the
+// temporal periphery, the nasal vessels fan out toward the nasal periphery; branches leave every
+// few millimetres, narrower than their parent, heading away from the disc; small macular branches
+// reach toward the fovea and stop at its avascular zone. Arteries are narrower than veins (about
+// 2:3) and drawn brighter red with a central light reflex; veins darker and wider.
 struct TreeBuilder {
   Rng& rng;
   double exclusion_mm;   // no vessel point comes closer to the fovea than this
@@ -67,46 +80,59 @@ struct TreeBuilder {
   Vec2 disc;
   std::vector<VesselSegment>& out;
   static constexpr double kStep = 0.15;
-  static constexpr std::size_t kMaxSegments = 60000;
+  static constexpr std::size_t kMaxSegments = 80000;
 
-  // Grows one vessel from p with heading `heading` (rad). `arc_sign` != 0 makes it arch around the
-  // fovea at `arc_radius` (+1 counter-clockwise), as the temporal arcades do.
-  void grow(Vec2 p, double heading, double width, bool artery, int depth, double arc_sign, double arc_radius,
-            double length_mm) {
+  // Where a vessel wants to go from p: a main trunk follows its waypoints (an arcade: up out of
+  // the disc, over the macula, on to the temporal periphery), heading for each in turn; other
+  // vessels head away from the disc.
+  struct Steer {
+    std::array<Vec2, 6> waypoints{};
+    int count = 0;
+    int next = 0;
+  };
+
+  Vec2 wanted(const Vec2& p, const Vec2& dir, Steer& st) const {
+    while (st.next < st.count) {
+      const Vec2 to = st.waypoints[static_cast<std::size_t>(st.next)] - p;
+      const bool reached = to.norm() < 0.8 ||
+                           (st.next + 1 < st.count && (st.waypoints[static_cast<std::size_t>(st.next + 1)] - p).norm() < to.norm());
+      if (!reached) return to.normalized();
+      ++st.next;
+    }
+    if (st.count > 0) return dir;  // past the last waypoint: on as it goes
+    const Vec2 away = p - disc;
+    return away.norm() > 1e-9 ? Vec2((0.3 * away.normalized() + 0.7 * dir).normalized()) : dir;
+  }
+
+  void grow(Vec2 p, double heading, double width, bool artery, int depth, Steer st, double length_mm,
+            double wander = 0.10) {
     double travelled = 0.0;
-    double next_branch = rng.uniform(1.2, 2.5);
+    double next_branch = rng.uniform(1.2, 2.8);
     while (travelled < length_mm && out.size() < kMaxSegments) {
-      Vec2 dir(std::cos(heading), std::sin(heading));
-      const double r = p.norm();
-      if (arc_sign != 0.0 && r > 1e-6) {
-        const Vec2 radial = p / r;
-        const Vec2 tangent = arc_sign * Vec2(-radial.y(), radial.x());
-        const double ang = std::atan2(p.y(), p.x());
-        // Past the temporal raphe (the far side from the disc) the arcade runs out to the periphery.
-        const bool beyond = std::abs(ang) > 0.8 * kPi;
-        Vec2 want = beyond ? Vec2(-1.0, 0.6 * radial.y()).normalized()
-                           : (tangent + 0.8 * (arc_radius - r) / arc_radius * radial).normalized();
-        if (!want.allFinite()) want = dir;
-        const double target = std::atan2(want.y(), want.x());
-        double d = std::remainder(target - heading, 2.0 * kPi);
-        heading += 0.25 * d;
-      }
-      heading += rng.uniform(-0.12, 0.12);
-      dir = Vec2(std::cos(heading), std::sin(heading));
-      const Vec2 q = p + kStep * dir;
+      const Vec2 dir(std::cos(heading), std::sin(heading));
+      const Vec2 w = wanted(p, dir, st);
+      heading += 0.22 * std::remainder(std::atan2(w.y(), w.x()) - heading, 2.0 * kPi);
+      heading += rng.uniform(-wander, wander);
+      const Vec2 q = p + kStep * Vec2(std::cos(heading), std::sin(heading));
       // Never into the foveal avascular zone; never past the ora.
-      if (q.norm() < exclusion_mm + 0.5 * width || q.norm() > extent_mm * 0.97) return;
+      if (q.norm() < exclusion_mm + 0.5 * width || q.norm() > extent_mm * 0.98) return;
       out.push_back({p, q, width, artery, depth});
       p = q;
       travelled += kStep;
-      width = std::max(0.02, width * (1.0 - 0.003));
-      if (travelled >= next_branch && depth < 5 && width > 0.03) {
-        next_branch = travelled + rng.uniform(1.0, 2.5);
-        const double side = rng.uniform() < 0.5 ? -1.0 : 1.0;
-        const double child_heading = heading + side * rng.uniform(0.45, 1.0);
+      width = std::max(0.015, width * (1.0 - 0.0015));
+      if (travelled >= next_branch && depth < 5 && width > 0.025) {
+        next_branch = travelled + rng.uniform(1.2, 2.8) * (1.0 + 0.3 * depth);
+        // Branch to the side away from the fovea mostly; toward it (macular branches) sometimes.
+        const Vec2 to_fovea = -p;
+        const double cross_z = std::cos(heading) * to_fovea.y() - std::sin(heading) * to_fovea.x();
+        const double toward = cross_z > 0.0 ? 1.0 : -1.0;
+        const bool macular = p.norm() < 7.0 && rng.uniform() < 0.45;
+        const double side = macular ? toward : (rng.uniform() < 0.7 ? -toward : toward);
+        const double child_heading = heading + side * rng.uniform(0.5, 1.0);
         const double child_width = width * rng.uniform(0.55, 0.75);
-        width *= 0.92;
-        grow(p, child_heading, child_width, artery, depth + 1, 0.0, 0.0, rng.uniform(2.0, 6.0) * (5 - depth) / 5.0 + 1.0);
+        width *= 0.93;
+        const double reach = macular ? rng.uniform(1.0, 3.0) : rng.uniform(4.0, 11.0) * (6 - depth) / 6.0 + 1.0;
+        grow(p, child_heading, child_width, artery, depth + 1, Steer{}, reach, 0.16);
       }
     }
   }
@@ -177,16 +203,26 @@ FundusTextures generate_fundus(const EyeModel& eye, const FundusOptions& o) {
   // ---- Vessel tree ---------------------------------------------------------------------------
   const double exclusion = ep.fovea_radius_mm + 0.1;
   TreeBuilder tree{rng, exclusion, extent, disc, t.vessels};
-  const double arc_r = std::max(ep.macula_radius_mm + 0.8, 0.9 * disc.x());
-  // Temporal arcades (arching around the macula) and nasal branches, artery + vein each.
-  for (int pair = 0; pair < 2; ++pair) {
-    const bool artery = pair == 0;
-    const double w = artery ? 0.10 : 0.13;
-    const double jitter = artery ? 0.0 : 0.12;
+  // The arcades pass above and below the fovea outside the macula, at a height that varies from
+  // eye to eye, and run on to the temporal periphery slowly diverging from the horizontal raphe.
+  const double height = std::max(ep.macula_radius_mm + 1.2, rng.uniform(4.3, 5.6));
+  const double reach = extent * 1.8;  // long enough to run to the ora
+  for (const bool artery : {false, true}) {  // veins first: arteries are drawn over them where they cross
+    const double w = artery ? 0.11 : 0.155;
     for (double sign : {1.0, -1.0}) {
-      const Vec2 start = disc + Vec2(0.0, sign * (0.2 + jitter));
-      tree.grow(start, sign * (kPi / 2 + 0.35 + jitter), w, artery, 0, sign, arc_r, extent * 1.6);
-      tree.grow(start, sign * (0.6 + jitter), 0.8 * w, artery, 0, 0.0, 0.0, extent - disc.x());
+      // Temporal arcade: up (down) out of the disc, over the macula, on to the temporal periphery.
+      const double offset = artery ? 0.18 : 0.42;  // the pair leaves the disc side by side
+      const double h = height + (artery ? 0.0 : 0.4) + rng.uniform(-0.25, 0.25);
+      const double spread = rng.uniform(1.0, 2.5);
+      TreeBuilder::Steer arcade;
+      arcade.waypoints = {Vec2(disc.x() - 0.4, sign * 0.45 * h), Vec2(0.5 * disc.x(), sign * 0.93 * h), Vec2(-2.0, sign * h),
+                          Vec2(-7.0, sign * (h + 0.4 * spread)), Vec2(-13.0, sign * (h + spread)),
+                          Vec2(-extent, sign * (h + 2.0 * spread))};
+      arcade.count = 6;
+      tree.grow(disc + Vec2(-0.1, sign * offset), sign * (kPi / 2 + rng.uniform(0.1, 0.4)), w, artery, 0, arcade, reach, 0.05);
+      // Nasal vessel: out toward the nasal periphery, up (down).
+      tree.grow(disc + Vec2(0.25, sign * offset), sign * rng.uniform(0.55, 0.95), 0.85 * w, artery, 0, TreeBuilder::Steer{},
+                extent - disc.x(), 0.07);
     }
   }
 
@@ -219,22 +255,35 @@ FundusTextures generate_fundus(const EyeModel& eye, const FundusOptions& o) {
       }
     }
   }
-  for (const auto& s : t.vessels) {
-    const double half = 0.5 * s.width_mm;
-    const double lo_x = std::min(s.a_mm.x(), s.b_mm.x()) - half - mm_per_px, hi_x = std::max(s.a_mm.x(), s.b_mm.x()) + half + mm_per_px;
-    const double lo_y = std::min(s.a_mm.y(), s.b_mm.y()) - half - mm_per_px, hi_y = std::max(s.a_mm.y(), s.b_mm.y()) + half + mm_per_px;
-    const int x0 = std::max(0, static_cast<int>((lo_x + extent) / mm_per_px));
-    const int x1 = std::min(n - 1, static_cast<int>((hi_x + extent) / mm_per_px));
-    const int y0 = std::max(0, static_cast<int>((lo_y + extent) / mm_per_px));
-    const int y1 = std::min(n - 1, static_cast<int>((hi_y + extent) / mm_per_px));
-    const double rr = s.artery ? 0.78 : 0.5, gg = s.artery ? 0.12 : 0.05, bb = s.artery ? 0.08 : 0.1;
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        const double d = distance_to_segment(to_mm(x, y), s.a_mm, s.b_mm);
-        // Coverage of a pixel by the vessel: 1 inside, fading over one pixel; thin vessels fade.
-        const double cover = std::clamp((half + 0.5 * mm_per_px - d) / mm_per_px, 0.0, 1.0) *
-                             std::min(1.0, s.width_mm / mm_per_px);
-        if (cover > 0.0) blend(t.retina.pixel(x, y), rr, gg, bb, 0.95 * cover);
+  // Veins (dark, wide) first, then arteries (bright red, narrower, with the light reflex along their
+  // centre that tells an artery at a glance).
+  for (const bool arteries : {false, true}) {
+    for (const auto& s : t.vessels) {
+      if (s.artery != arteries) continue;
+      const double half = 0.5 * s.width_mm;
+      const double lo_x = std::min(s.a_mm.x(), s.b_mm.x()) - half - mm_per_px, hi_x = std::max(s.a_mm.x(), s.b_mm.x()) + half + mm_per_px;
+      const double lo_y = std::min(s.a_mm.y(), s.b_mm.y()) - half - mm_per_px, hi_y = std::max(s.a_mm.y(), s.b_mm.y()) + half + mm_per_px;
+      const int x0 = std::max(0, static_cast<int>((lo_x + extent) / mm_per_px));
+      const int x1 = std::min(n - 1, static_cast<int>((hi_x + extent) / mm_per_px));
+      const int y0 = std::max(0, static_cast<int>((lo_y + extent) / mm_per_px));
+      const int y1 = std::min(n - 1, static_cast<int>((hi_y + extent) / mm_per_px));
+      const double rr = s.artery ? kArtery[0] : kVein[0], gg = s.artery ? kArtery[1] : kVein[1], bb = s.artery ? kArtery[2] : kVein[2];
+      for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+          const double d = distance_to_segment(to_mm(x, y), s.a_mm, s.b_mm);
+          // Coverage of a pixel by the vessel: 1 inside, fading over one pixel; thin vessels fade.
+          const double cover = std::clamp((half + 0.5 * mm_per_px - d) / mm_per_px, 0.0, 1.0) *
+                               std::min(1.0, s.width_mm / mm_per_px);
+          if (cover <= 0.0) continue;
+          std::uint8_t* px = t.retina.pixel(x, y);
+          blend(px, rr, gg, bb, 0.95 * cover);
+          // The arterial reflex: a lighter stripe a third of the vessel wide along its centre (only
+          // where the vessel spans enough texels to carry it without aliasing into dots).
+          if (s.artery && s.width_mm > 3.0 * mm_per_px) {
+            const double reflex = std::clamp((0.17 * s.width_mm + 0.5 * mm_per_px - d) / mm_per_px, 0.0, 1.0);
+            if (reflex > 0.0) blend(px, 0.92, 0.50, 0.40, 0.45 * reflex);
+          }
+        }
       }
     }
   }

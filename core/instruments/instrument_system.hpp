@@ -1,14 +1,15 @@
 #pragma once
-// The instruments in the eye, stepped with the tissue: each step the rig sets every instrument's
-// input (tracked pose, handle, pedal) and calls step(); the system works out the eye's rotation, the
-// instruments' collision shapes, hands the tissue contact candidates (FCL broad phase,
-// core/collision) and the grasps, suction and adhesions to the TissueWorld, steps it, and reports
-// contact forces, iatrogenic events, laser burns, the fluid level and the eye rotation.
+// The instruments in the eye: their state, their collision shapes and what they do to the tissue.
+// The simulation step (core/sim/simulation.hpp) calls the instruments' stages in order — place them
+// in the eye frame (stage_place.cpp), find the tissue they may touch (stage_contacts.cpp), act
+// (stage_act.cpp: grasps, laser, vitrector suction, blades), then after the tissue step feel what the
+// tissue did (stage_sense.cpp: contact forces, events) and hand over cuts and removals.
 //
-// Cutting and removal are topology changes, which belong to core/topology: the blades, scissors and
-// vitrector describe what they sweep or draw in (BladeSweep, RemovalRequest) and hand it to a
-// TopologyActions implementation at the step boundary; without one the requests are still listed
-// each step for the rig and the tests.
+// Cutting and removal are topology changes, which belong to core/topology: the blades and scissors
+// hand their cutting edges' pose every step (CuttingPose: core/topology follows each incision pose by
+// pose, so what is cut does not depend on the step length) and the vitrector what it draws in
+// (RemovalRequest) to a TopologyActions implementation at the step boundary; without one they are
+// still listed each step for the rig and the tests, with each blade's swept quad (BladeSweep).
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -19,7 +20,9 @@
 #include "core/collision/collision_scene.hpp"
 #include "core/common/status.hpp"
 #include "core/instruments/instrument.hpp"
+#include "core/instruments/instrument_events.hpp"
 #include "core/tissue/tissue_world.hpp"
+#include "core/topology/vitrector.hpp"
 
 namespace vitreo::core {
 
@@ -33,6 +36,22 @@ struct BladeSweep {
   Vec3 a1 = Vec3::Zero(), b1 = Vec3::Zero();  // edge at the end of the step
 };
 
+// A cutting instrument's edges at the end of a step, handed over every step while it is in the eye
+// and once more, with in_eye false, the step it leaves (its incisions end there).
+struct CuttingPose {
+  std::uint32_t instrument = 0;
+  InstrumentKind kind = InstrumentKind::kBlade;
+  bool in_eye = true;
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();  // blades: the sharp edge (eye frame)
+  // Scissors: the hinge, the bisector of the jaws and the normal of their plane, the opening between
+  // the jaws (rad) and their length.
+  Vec3 hinge = Vec3::Zero();
+  Vec3 bisector = Vec3::UnitX();
+  Vec3 normal = Vec3::UnitZ();
+  double opening_rad = 0.0;
+  double jaw_length_mm = 0.0;
+};
+
 // Vitrector removal for one step: tissue inside the removal hemisphere (radius, in front of the port
 // along its normal) is cut away at the cut rate; suction (the outer hemisphere) is already applied.
 struct RemovalRequest {
@@ -41,43 +60,18 @@ struct RemovalRequest {
   Vec3 port_normal = Vec3::UnitZ();
   double removal_radius_mm = 0.0;
   double suction_radius_mm = 0.0;
-  double vacuum = 0.0;        // 0..1 of maximum (pedal)
-  double cut_rate_hz = 0.0;   // 0: not cutting
+  double vacuum = 0.0;         // 0..1 of maximum (pedal)
+  double cut_rate_cpm = 0.0;   // cuts per minute; 0: not cutting
   double dt_s = 0.0;
 };
 
 // Consumer of cuts and removals: core/topology implements it (the adapter point). Called after
-// TissueWorld::step, at the step boundary, once per sweep/request.
+// TissueWorld::step, at the step boundary, once per cutting pose/request.
 class TopologyActions {
  public:
   virtual ~TopologyActions() = default;
-  virtual void cut(TissueWorld& world, const BladeSweep& sweep) = 0;
+  virtual void cut(TissueWorld& world, const CuttingPose& pose) = 0;
   virtual void remove(TissueWorld& world, const RemovalRequest& request) = 0;
-};
-
-enum class InstrumentEventKind : std::uint8_t {
-  kExcessiveRetinaForce,  // magnitude: contact force on the retina (µN)
-  kUnintendedTear,        // a tear in the retina; magnitude: strain
-  kLaserOnDetachedRetina, // burn without adhesion; magnitude: clearance from the choroid (mm)
-  kLightTooClose,         // the light pipe within the safe distance of the macula; magnitude: distance
-  kLightToxicity,         // the macular light dose passed the limit; magnitude: dose (J/cm²)
-  kInstrumentCollision,   // two instruments touch; `other` is the second; magnitude: depth (mm)
-  kLensTouch,             // magnitude: depth (mm)
-  kWallContact,           // the tip pressed into the globe wall; magnitude: depth (mm)
-  kGrasp,                 // forceps closed on tissue; magnitude: distance to the grasp point (mm)
-  kGraspLost,             // the grasped tissue pulled out of the jaws / tore away; magnitude: force
-  kRelease,
-  kAttachmentBroken,      // passed on from the tissue; magnitude: force (µN)
-  kLaserBurn,             // magnitude: burn diameter (mm)
-};
-const char* to_string(InstrumentEventKind k);
-
-struct InstrumentEvent {
-  InstrumentEventKind kind;
-  std::uint32_t instrument;  // kNone when not tied to one
-  std::uint32_t other;       // second instrument, surface, … (kNone when unused)
-  Vec3 position_mm;
-  double magnitude;
 };
 
 struct BurnSpot {
@@ -131,10 +125,7 @@ struct InstrumentSceneOptions {
   double adhesion_stiffness_un_per_mm = 2e5;
   double laser_spot_mm = 0.2;             // aiming-beam spot; burn diameter scales with energy
   double laser_reference_energy_mj = 20.0;
-  double vitrector_suction_pa = 300.0;    // at full vacuum
-  double vitrector_field_mm = 1.5;        // suction hemisphere radius at full vacuum
-  double vitrector_removal_mm = 0.3;
-  double vitrector_cut_rate_hz = 125.0;   // 7500 cuts/min
+  VitrectorSettings vitrector;            // suction, removal and cut rate: one model (core/topology/vitrector.hpp)
   double aspiration_level_rate_mm_s = 2.0;
   double drainage_rate_per_s = 0.5;       // detachment scale drained per second at full aspiration
   double light_half_angle_deg = 40.0;
@@ -158,64 +149,42 @@ struct InstrumentState {
   Vec3 aim_point_mm = Vec3::Zero();
 };
 
-struct EyeRotation {
-  Vec3 rotation_vector_rad = Vec3::Zero();  // eye relative to the fixture (axis × angle)
-  Vec3 torque_un_mm = Vec3::Zero();         // of the ports on the eye
-  bool from_rig = false;                    // set by set_eye_fixture_rotation
-  Quat rotation() const;
-};
-
-struct LightExposure {
-  bool active = false;
-  Vec3 apex_mm = Vec3::Zero();
-  Vec3 axis = Vec3::UnitZ();
-  double half_angle_rad = 0.0;
-  double macula_distance_mm = std::numeric_limits<double>::infinity();
-  double macula_dose_j_cm2 = 0.0;
-};
-
-struct InstrumentStepReport {
-  StepReport tissue;
-  std::uint32_t candidates = 0;
-  std::uint32_t patches_refit = 0;
-};
-
 class InstrumentSystem {
  public:
   // Throws InvalidArgument on bad options (ports out of range, non-finite data).
   InstrumentSystem(TissueWorld& world, InstrumentSceneOptions options, std::vector<InstrumentDescription> instruments);
   ~InstrumentSystem();
 
-  void set_topology(TopologyActions* topology) { topology_ = topology; }
-  // Per step, before step(): never throws, refuses non-finite input.
+  // Per step, before the step: never throws, refuses non-finite input.
   Status set_input(std::uint32_t instrument, const InstrumentInput& input);
-  // A rig whose mock eye really rotates reports it here; otherwise (nullopt) the rotation is simulated.
-  void set_eye_fixture_rotation(std::optional<Quat> rotation);
-  void set_air_infusion(bool on) { air_infusion_ = on; }
 
-  InstrumentStepReport step(double dt_s);
+  // ---- The instruments' stages, in the order the simulation step calls them ----------------------
+  // Clears the step's lists (sweeps, removals, suction).
+  void begin_step();
+  // Frames and tips in the eye frame (fixture_to_eye: the eye's rotation, inverted) and the
+  // colliders, swept from the last step's tips (stage_place.cpp).
+  void place(const Quat& fixture_to_eye);
+  // The tissue triangles the colliders may touch, and their vertices woken (stage_contacts.cpp).
+  void find_contacts();
+  // Grasps, laser shots, vitrector suction and removal requests, blade sweeps; hands colliders,
+  // contact candidates and suction fields to the tissue world (stage_act.cpp).
+  void act(double dt, InstrumentEvents& events);
+  // After the tissue step: contact and grip forces, overload, the tissue's events as the instruments'
+  // (tears, lost grasps, broken attachments), lens, wall and instrument–instrument contacts
+  // (stage_sense.cpp).
+  void sense(const StepReport& tissue, InstrumentEvents& events);
+  // Cuts and removals to core/topology, at the step boundary (stage_sense.cpp).
+  void hand_over_topology(TopologyActions& topology);
+  // This step's inputs and tips become the last step's (blade sweeps, grasp edges).
+  void end_step();
 
-  // Optional timing hook for benchmarks and the rig's profiler (core reads no clock): called with
-  // phase 0 at the start of step(), 1 after collision and the instruments' own work, 2 after the
-  // tissue step (whose substeps resolve the contacts), 3 at the end.
-  using PhaseProbe = void (*)(int phase, void* user);
-  void set_phase_probe(PhaseProbe probe, void* user) {
-    probe_ = probe;
-    probe_user_ = user;
-  }
-
-  // ---- Outputs of the last step ----------------------------------------------------------------
+  // ---- State ----------------------------------------------------------------------------------------
   std::uint32_t instrument_count() const { return static_cast<std::uint32_t>(state_.size()); }
   const InstrumentState& instrument(std::uint32_t i) const { return state_.at(i); }
-  const std::vector<InstrumentEvent>& events() const { return events_; }
   const std::vector<BurnSpot>& burns() const { return burns_; }
   const std::vector<BladeSweep>& blade_sweeps() const { return sweeps_; }
+  const std::vector<CuttingPose>& cutting_poses() const { return poses_; }
   const std::vector<RemovalRequest>& removal_requests() const { return removals_; }
-  const EyeRotation& eye_rotation() const { return eye_; }
-  const LightExposure& light() const { return light_; }
-  // The fluid–gas boundary (+infinity: all fluid). The tissue world's environment follows it in
-  // 0.05 mm increments (each change re-evaluates buoyancy everywhere, so it is not pushed every step).
-  double fluid_level_z_mm() const { return fluid_level_; }
   const InstrumentSceneOptions& options() const { return options_; }
   const CollisionStats& collision_stats() const { return collision_->stats(); }
   const CollisionScene& collision() const { return *collision_; }
@@ -223,41 +192,27 @@ class InstrumentSystem {
   Vec3 burn_position(const BurnSpot& burn) const;
 
  private:
-  void solve_eye_rotation();
-  void place_instruments();
-  void update_grasps();
-  void update_laser(double dt);
-  void update_fluid(double dt);
-  void update_light(double dt);
-  void rigid_contacts();
-  void after_step(const StepReport& report, double dt);
-  void emit(InstrumentEventKind kind, std::uint32_t instrument, std::uint32_t other, const Vec3& p, double magnitude);
+  void update_grasps(InstrumentEvents& events);
+  void update_laser(InstrumentEvents& events);
+  void draw_in_and_sweep(double dt);
+  CuttingPose cutting_pose(std::uint32_t instrument) const;
+  void rigid_contacts(InstrumentEvents& events);
 
   TissueWorld& world_;
   InstrumentSceneOptions options_;
   std::unique_ptr<CollisionScene> collision_;
-  TopologyActions* topology_ = nullptr;
-  PhaseProbe probe_ = nullptr;
-  void* probe_user_ = nullptr;
   std::vector<InstrumentState> state_;
   std::vector<InstrumentInput> previous_input_;
   std::vector<TipGeometry> previous_tip_;
   std::vector<std::uint8_t> was_inside_;
-  std::optional<Quat> rig_rotation_;
-  EyeRotation eye_;
-  bool air_infusion_ = false;
-  double fluid_level_ = std::numeric_limits<double>::infinity();
-  LightExposure light_;
-  bool light_close_reported_ = false;
-  bool light_dose_reported_ = false;
 
   std::vector<ColliderCapsule> colliders_;
   std::vector<std::uint32_t> collider_owner_;
   std::vector<ContactCandidate> candidates_;
   std::vector<SuctionField> suction_;
-  std::vector<InstrumentEvent> events_;
   std::vector<BurnSpot> burns_;
   std::vector<BladeSweep> sweeps_;
+  std::vector<CuttingPose> poses_;
   std::vector<RemovalRequest> removals_;
   std::vector<std::uint8_t> pair_touching_, lens_touching_, wall_touching_, retina_overloaded_;
 };

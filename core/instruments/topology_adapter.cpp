@@ -8,6 +8,9 @@ TopologyAdapter::TopologyAdapter(TissueWorld& world, const std::vector<std::uint
     if (s >= world.surface_count()) throw InvalidArgument("topology adapter: cut surface out of range");
     cutters_.push_back(std::make_unique<Cutter>(world.surface(s), cut));
   }
+  for (std::uint32_t i = 0; i < kMaxInstruments; ++i) {
+    for (auto& c : cutters_) edges_.push_back(std::make_unique<Edges>(Edges{Incision(*c), Scissors(*c, 1.0)}));
+  }
   vitrector.removal_radius_mm = std::max(vitrector.removal_radius_mm, 1e-3);
   for (auto s : removal_surfaces) {
     if (s >= world.surface_count()) throw InvalidArgument("topology adapter: removal surface out of range");
@@ -15,22 +18,43 @@ TopologyAdapter::TopologyAdapter(TissueWorld& world, const std::vector<std::uint
   }
 }
 
-void TopologyAdapter::cut(TissueWorld& /*world*/, const BladeSweep& sweep) {
-  // A blade moved along its own edge (plunging straight in) sweeps no area and cuts nothing new.
-  const double area = 0.5 * (sweep.b1 - sweep.a0).cross(sweep.a1 - sweep.b0).norm();
-  if (cutters_.empty() || !(area > 1e-9)) return;
-  for (auto& c : cutters_) {
-    const CutResult r = c->sweep({sweep.a0, sweep.b0}, {sweep.a1, sweep.b1});
-    if (!r.status) last_error_ = r.status;
-    springs_opened_ += r.springs_opened;
+void TopologyAdapter::note(const CutResult& r) {
+  if (!r.status) last_error_ = r.status;
+  springs_opened_ += r.springs_opened;
+  gaps_ += r.gaps;
+}
+
+void TopologyAdapter::cut(TissueWorld& /*world*/, const CuttingPose& pose) {
+  if (cutters_.empty()) return;
+  if (pose.instrument >= kMaxInstruments) {
+    last_error_ = Status::error("topology adapter: more cutting instruments than it has room for");
+    return;
+  }
+  for (std::size_t k = 0; k < cutters_.size(); ++k) {
+    Edges& e = *edges_[pose.instrument * cutters_.size() + k];
+    if (!pose.in_eye) {  // the instrument left the eye: its cuts end where it last was
+      note(e.blade.end());
+      note(e.scissors.release());
+      continue;
+    }
+    if (pose.kind == InstrumentKind::kScissors) {
+      if (const Status s = e.scissors.set_blade_length(pose.jaw_length_mm); !s) {
+        last_error_ = s;
+        continue;
+      }
+      note(e.scissors.set_pose(pose.hinge, pose.bisector, pose.normal, pose.opening_rad));
+    } else {
+      // A blade moved along its own edge (plunging straight in) sweeps no area: the incision
+      // records the pose and cuts nothing new.
+      note(e.blade.advance({pose.a, pose.b}));
+    }
   }
 }
 
 void TopologyAdapter::remove(TissueWorld& /*world*/, const RemovalRequest& request) {
   for (auto& v : vitrectors_) {
     Status s = v->set_pose(request.port_center_mm, request.port_normal);
-    if (s) s = v->set_vacuum(0.0);  // attraction is the solver's SuctionField
-    if (s) s = v->set_cut_rate(std::min(request.cut_rate_hz * 60.0, v->settings().max_cut_rate_cpm));
+    if (s) s = v->set_cut_rate(std::min(request.cut_rate_cpm, v->settings().max_cut_rate_cpm));
     if (!s) {
       last_error_ = s;
       continue;

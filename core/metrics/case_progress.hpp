@@ -90,13 +90,17 @@ class CaseProgress {
   // Tangential distance (along the wall, mm) from p to the nearest laser-ring guide; +inf if none.
   double distance_to_laser_ring(const Vec3& p) const;
 
- private:
+  // The points along each measured guide (path_cut, laser_coverage) and which of them the last
+  // evaluate() found done — what the renderer colours as progress along the guide.
   struct GuideSamples {
-    std::uint32_t guide = 0;
+    std::uint32_t guide = 0;      // index into description().guides
     std::vector<Vec3> points;
     std::vector<double> weights;  // arc length each point stands for
     std::vector<std::uint8_t> covered;
   };
+  const std::vector<GuideSamples>& guide_samples() const { return samples_; }
+
+ private:
   double path_cut_fraction(const TissueWorld& world, GuideSamples& g) const;
   double laser_fraction(const TissueWorld& world, const InstrumentSystem* instruments, GuideSamples& g) const;
   double retina_lift_mm(const TissueWorld& world) const;

@@ -16,33 +16,33 @@ void MetricsOptions::validate() const {
   scores.validate();
 }
 
-SessionMetrics::SessionMetrics(const Scene& scene, const InstrumentSystem* instruments, MetricsOptions options)
-    : SessionMetrics(scene.world, MetricsCase::from_scene(scene), instruments, std::move(options)) {}
+SessionMetrics::SessionMetrics(const Scene& scene, const Simulation* sim, MetricsOptions options)
+    : SessionMetrics(scene.world, MetricsCase::from_scene(scene), sim, std::move(options)) {}
 
-SessionMetrics::SessionMetrics(const TissueWorld& world, MetricsCase c, const InstrumentSystem* instruments,
+SessionMetrics::SessionMetrics(const TissueWorld& world, MetricsCase c, const Simulation* sim,
                                MetricsOptions options)
     : world_(world),
-      instruments_(instruments),
+      sim_(sim),
       options_((options.validate(), std::move(options))),
       progress_(world, std::move(c), options_.progress) {
   for (const auto& spec : progress_.description().criteria) {
     if (spec.kind == CriterionKind::kTimeLimit) time_limit_s_ = time_limit_s_ > 0.0 ? std::min(time_limit_s_, spec.threshold) : spec.threshold;
   }
   totals_.force_limit_un = options_.retina_force_limit_un;
-  if (instruments_) {
-    if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = instruments_->options().retina_force_limit_un;
-    const std::uint32_t n = instruments_->instrument_count();
+  if (sim_) {
+    if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = sim_->options().retina_force_limit_un;
+    const std::uint32_t n = sim_->instrument_count();
     per_instrument_.resize(n);
     last_tip_.assign(n, Vec3::Zero());
     was_inside_.assign(n, 0);
     for (std::uint32_t i = 0; i < n; ++i) {
-      const InstrumentState& st = instruments_->instrument(i);
+      const InstrumentState& st = sim_->instrument(i);
       per_instrument_[i].kind = st.description.kind;
       last_tip_[i] = st.frame.tip;
       was_inside_[i] = st.inside ? 1 : 0;
       if (st.description.kind == InstrumentKind::kLightPipe) totals_.illumination_measured = true;
     }
-    burns_seen_ = instruments_->burns().size();
+    burns_seen_ = sim_->burns().size();
   }
   if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = InstrumentSceneOptions{}.retina_force_limit_un;
   last_world_step_ = world_.step_count();
@@ -69,13 +69,13 @@ Status SessionMetrics::observe(double dt) {
       ++totals_.other_tears;
     }
   }
-  if (!instruments_) return Status::ok();
+  if (!sim_) return Status::ok();
 
   const double limit = totals_.force_limit_un;
-  const LightExposure& light = instruments_->light();
+  const LightExposure& light = sim_->light();
   const double cos_cone = std::cos(light.half_angle_rad);
   for (std::uint32_t i = 0; i < per_instrument_.size(); ++i) {
-    const InstrumentState& st = instruments_->instrument(i);
+    const InstrumentState& st = sim_->instrument(i);
     InstrumentMetrics& m = per_instrument_[i];
     // Odometer: only the path between two steps the tip spent inside the eye.
     if (st.inside && was_inside_[i]) {
@@ -117,11 +117,11 @@ Status SessionMetrics::observe(double dt) {
     }
   }
 
-  for (const InstrumentEvent& e : instruments_->events()) {
+  for (const InstrumentEvent& e : sim_->events()) {
     const auto k = static_cast<std::size_t>(e.kind);
     if (k < totals_.events.size()) ++totals_.events[k];
   }
-  const auto& burns = instruments_->burns();
+  const auto& burns = sim_->burns();
   for (; burns_seen_ < burns.size(); ++burns_seen_) {
     const BurnSpot& b = burns[burns_seen_];
     if (progress_.distance_to_laser_ring(b.position_mm) <= options_.laser_target_band_mm) {
@@ -134,7 +134,7 @@ Status SessionMetrics::observe(double dt) {
 }
 
 const std::vector<CriterionProgress>& SessionMetrics::criteria() {
-  progress_.evaluate(world_, instruments_, totals_.elapsed_s);
+  progress_.evaluate(world_, sim_ ? &sim_->instruments() : nullptr, totals_.elapsed_s);
   return progress_.criteria();
 }
 

@@ -5,9 +5,10 @@
 // and, on demand, the case's criteria and the scores (case_progress.hpp, score_card.hpp).
 //
 //   core::Scene scene = core::build_scene(description);
-//   core::InstrumentSystem instruments(scene.world, options, tools);
-//   core::SessionMetrics metrics(scene, &instruments);
-//   loop: instruments.set_input(...); instruments.step(dt); (void)metrics.observe(dt);
+//   core::Simulation sim(scene.world, options, tools);
+//   core::SessionMetrics metrics(scene, &sim);
+//   sim.set_observer(&metrics);            // the step's last stage observes (or call observe(dt))
+//   loop: sim.set_input(...); sim.step(dt);
 //   metrics.criteria(), metrics.score()   // at a lower rate (each scans the world)
 //
 // Like the rest of core: no clock (dt is given), no allocation in observe() after construction,
@@ -16,7 +17,7 @@
 #include <vector>
 
 #include "core/common/status.hpp"
-#include "core/instruments/instrument_system.hpp"
+#include "core/sim/simulation.hpp"
 #include "core/metrics/case_progress.hpp"
 #include "core/metrics/score_card.hpp"
 #include "core/scene/scene_builder.hpp"
@@ -26,7 +27,7 @@ namespace vitreo::core {
 struct MetricsOptions {
   // An instrument touches the retina while the retina's contact force on it exceeds this (µN).
   double contact_force_un = 1.0;
-  // Force above which the retina is damaged (µN); ≤ 0: the InstrumentSystem's retina_force_limit_un.
+  // Force above which the retina is damaged (µN); ≤ 0: the instruments' retina_force_limit_un.
   double retina_force_limit_un = 0.0;
   // A burn counts as on target within this distance (along the wall) of a laser-ring guide.
   double laser_target_band_mm = 0.5;
@@ -46,19 +47,21 @@ struct InstrumentMetrics {
   bool touching_retina = false;           // now
 };
 
-class SessionMetrics {
+class SessionMetrics final : public StepObserver {
  public:
-  // From a built scene; instruments may be null (tissue-only metrics). The metrics keep references
-  // to the world and the instruments: both must outlive them. Throws InvalidArgument on bad options
-  // or criteria that name what the case lacks.
-  SessionMetrics(const Scene& scene, const InstrumentSystem* instruments, MetricsOptions options = {});
+  // From a built scene; sim may be null (tissue-only metrics). The metrics keep references to the
+  // world and the simulation: both must outlive them. Throws InvalidArgument on bad options or
+  // criteria that name what the case lacks.
+  SessionMetrics(const Scene& scene, const Simulation* sim, MetricsOptions options = {});
   // From a world built another way (core/anatomy/retina_cap), described by hand.
-  SessionMetrics(const TissueWorld& world, MetricsCase c, const InstrumentSystem* instruments, MetricsOptions options = {});
+  SessionMetrics(const TissueWorld& world, MetricsCase c, const Simulation* sim, MetricsOptions options = {});
 
-  // Once after each physics step (InstrumentSystem::step or TissueWorld::step) of dt_s seconds.
+  // Once after each physics step (Simulation::step or TissueWorld::step) of dt_s seconds.
   // Refuses (changing nothing) a dt that is not finite and in (0, 0.02], and a second call without a
   // world step in between (it would count the step's events twice).
   Status observe(double dt_s);
+  // The simulation's last stage, when registered with Simulation::set_observer.
+  void after_step(double dt_s) override { (void)observe(dt_s); }
 
   const SessionTotals& totals() const { return totals_; }
   const InstrumentMetrics& instrument(std::uint32_t i) const { return per_instrument_.at(i); }
@@ -71,10 +74,13 @@ class SessionMetrics {
   bool complete();
   // Criteria, then the scores (no allocation).
   const ScoreCard& score();
+  // What the last score() / criteria() found, without measuring again (the picture shows these).
+  const ScoreCard& last_score() const { return card_; }
+  const CaseProgress& progress() const { return progress_; }
 
  private:
   const TissueWorld& world_;
-  const InstrumentSystem* instruments_;
+  const Simulation* sim_;
   MetricsOptions options_;
   CaseProgress progress_;
   SessionTotals totals_;

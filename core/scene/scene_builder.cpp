@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "core/common/validate.hpp"
-#include "core/scene/world_access.hpp"
 #include "core/topology/clean_topology.hpp"
 
 namespace vitreo::core {
@@ -609,7 +608,7 @@ SettleReport settle_world(TissueWorld& world, const SettleSpec& spec) {
   // Let still regions (most of the retina, lying on the wall) fall asleep early: settling only has
   // to follow what still moves.
   settling.sleep_after_steps = std::min(surgery.sleep_after_steps, 20);
-  WorldAccess::set_settings(world, settling);
+  world.replace_settings(settling);
   // Speed measured as real displacement over the check interval of the fastest free vertex: most
   // of the retina lies still on the wall, so an average would call a rising detachment settled, and
   // a vertex held against the wall can carry a velocity it never travels.
@@ -645,8 +644,8 @@ SettleReport settle_world(TissueWorld& world, const SettleSpec& spec) {
       break;
     }
   }
-  WorldAccess::set_settings(world, surgery);
-  WorldAccess::set_clock(world, 0, 0.0);
+  world.replace_settings(surgery);
+  world.reset_clock();
   return r;
 }
 

@@ -50,6 +50,14 @@ const char* to_string(CriterionKind k) {
   return "?";
 }
 
+const char* to_string(GelStain s) {
+  switch (s) {
+    case GelStain::kClear: return "none";
+    case GelStain::kTriamcinolone: return "triamcinolone";
+  }
+  return "?";
+}
+
 const std::vector<std::string>& known_instruments() {
   static const std::vector<std::string> names{"vitrector", "forceps",   "scissors", "pick",
                                               "laser",     "light_pipe", "backflush", "infusion"};
@@ -199,6 +207,13 @@ void SceneDescription::validate() const {
       case CriterionKind::kRetinaFlat: require_range(c.threshold, 0.0, 10.0, w + "threshold"); break;
       case CriterionKind::kTimeLimit: require_range(c.threshold, 1.0, 7200.0, w + "threshold"); break;
     }
+  }
+  if (view.region_of_interest) {
+    location("view: region_of_interest", *view.region_of_interest);
+    require_range(view.region_of_interest->polar_deg, 0.0, 90.0, "view: region_of_interest: polar_deg");
+  }
+  if (view.gel_stain != GelStain::kClear && anatomy.gel_shells == 0) {
+    throw InvalidArgument("view: gel_stain needs gel (anatomy.gel_shells > 0)");
   }
   if (settle.max_steps < 0 || settle.max_steps > 20000) throw InvalidArgument("settle: max_steps must be in [0, 20000]");
   if (settle.min_steps < 0 || settle.min_steps > settle.max_steps) throw InvalidArgument("settle: min_steps must be in [0, max_steps]");

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,20 @@ struct CriterionSpec {
   double threshold = 0.9;
 };
 
+// How the case is seen (not physics): where the microscope starts, what the gel looks like, the
+// lighting. Read by the rig's microscope and renderer only; a change here never moves tissue.
+enum class GelStain : std::uint8_t { kClear, kTriamcinolone };
+struct ViewSpec {
+  // Where the microscope's field starts; unset: the pathology the case is about (its first tear,
+  // membrane, detachment or guide), else the fovea.
+  std::optional<FundusLocation> region_of_interest;
+  // The vitreous as the surgeon sees it: clear (a faint haze) or stained white with triamcinolone
+  // crystals, as surgeons do to see the gel they are removing. Needs gel (anatomy.gel_shells > 0).
+  GelStain gel_stain = GelStain::kClear;
+  bool wide_angle = false;  // the case starts with the wide-angle viewing system swung in
+  bool chandelier = false;  // a chandelier fibre in the superior pars plana lights the cavity
+};
+
 struct SettleSpec {
   int max_steps = 800;
   int min_steps = 100;
@@ -129,6 +144,7 @@ struct SceneDescription {
   std::vector<GuideSpec> guides;
   std::vector<CriterionSpec> criteria;
   SettleSpec settle;
+  ViewSpec view;
   std::string source_file;  // where it was read from (diagnostics)
 
   // Checks cross-references and ranges; throws InvalidArgument naming the item.
@@ -139,6 +155,7 @@ const char* to_string(MembraneKind k);
 const char* to_string(AttachmentStrength s);
 const char* to_string(GuideKind k);
 const char* to_string(CriterionKind k);
+const char* to_string(GelStain s);
 // Names accepted for instruments.
 const std::vector<std::string>& known_instruments();
 

@@ -5,7 +5,6 @@
 #include <fstream>
 #include <iterator>
 
-#include "core/scene/world_access.hpp"
 
 namespace vitreo::core {
 
@@ -56,7 +55,7 @@ void encode_snapshot(const TissueWorld& world, const std::string& scene_name, st
   put(out, static_cast<std::uint64_t>(scene_name.size()));
   put_bytes(out, scene_name.data(), scene_name.size());
   put(out, world.state_hash());
-  WorldAccess::write_state(world, out);
+  world.write_state(out);
   const std::uint64_t size = out.size() - kHeaderBytes;
   const std::uint64_t checksum = fnv1a(out.data() + kHeaderBytes, static_cast<std::size_t>(size));
   std::memcpy(out.data() + 16, &size, sizeof size);
@@ -90,7 +89,7 @@ Status decode_snapshot(TissueWorld& world, std::span<const std::uint8_t> bytes, 
   si.scene_name.assign(reinterpret_cast<const char*>(p + 8), static_cast<std::size_t>(name_len));
   si.state_hash = get<std::uint64_t>(p + 8 + name_len);
   const std::size_t offset = 16 + static_cast<std::size_t>(name_len);
-  const Status st = WorldAccess::read_state(world, p + offset, static_cast<std::size_t>(size) - offset);
+  const Status st = world.read_state(p + offset, static_cast<std::size_t>(size) - offset);
   if (!st) return st;
   if (world.state_hash() != si.state_hash) return Status::error("snapshot: state hash differs after loading");
   if (info) *info = si;

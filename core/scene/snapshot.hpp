@@ -7,7 +7,8 @@
 // enough): the static parts (globe wall, pool capacities) come from the scene, the state from the
 // file. Format (little-endian):
 //   "VTRSNAP\0" | u32 version | u32 flags (0) | u64 payload bytes | u64 FNV-1a-64 of the payload | payload
-// payload = scene name, state hash, then the world state (world_access.cpp). Files are written to a
+// payload = scene name, state hash, then the world state (TissueWorld::write_state: the field lists in
+// core/tissue/tissue_world_state.cpp and surface_state.cpp). Files are written to a
 // temporary name and renamed, so a reader never sees half a snapshot.
 #include <cstdint>
 #include <span>
@@ -19,7 +20,10 @@
 
 namespace vitreo::core {
 
-inline constexpr std::uint32_t kSnapshotVersion = 4;  // 2: the solver's wake lengths; 3: sleep groups are derived, not stored; 4: warm-start forces and bending
+// Compatibility is by version, explicitly: a change to any state_io field list changes the payload,
+// so it bumps this number; a snapshot of another version is refused with both numbers (and cached
+// case starts, keyed on it, are settled again).
+inline constexpr std::uint32_t kSnapshotVersion = 4;  // 2: the solver's wake lengths; 3: sleep groups are derived, not stored; 4: VBD (bending, start state; no multipliers)
 
 struct SnapshotInfo {
   std::uint32_t version = 0;

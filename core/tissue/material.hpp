@@ -65,4 +65,20 @@ struct TissueMaterial {
   void validate() const;
 };
 
+// The material's fields, listed once for snapshots in both directions (core/common/state_io.hpp).
+template <class IO, class M>
+void material_io(IO& io, M& m) {
+  io.str(m.name);
+  io.pod(m.density_g_per_mm3);
+  io.pod(m.thickness_mm);
+  io.pod(m.membrane_modulus_pa_mm);
+  io.pod(m.bending_modulus_un_mm);
+  io.pod(m.tear_strain);
+  io.pod(m.drag_pa_s_per_mm);
+  io.pod(m.internal_damping_s);
+  io.pod(m.entrained_fluid_mm);
+  io.pod(m.plastic_yield_strain);
+  io.pod(m.plastic_rate_per_s);
+}
+
 }  // namespace vitreo::core

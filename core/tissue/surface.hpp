@@ -22,6 +22,7 @@
 #include <span>
 #include <vector>
 
+#include "core/common/state_io.hpp"
 #include "core/common/status.hpp"
 #include "core/common/types.hpp"
 #include "core/geometry/triangle_mesh.hpp"
@@ -333,6 +334,14 @@ class Surface {
   std::uint32_t spring_log_at(std::uint64_t position) const { return spring_log_[position % kSpringLogSize]; }
   void forget_spring_log() { spring_log_kept_from_ = ++spring_log_end_; }  // every reader's position is lost
 
+  // ---- State I/O (snapshots, core/scene/snapshot.hpp) ------------------------------------------
+  // The mutable state, every field listed once in state_io() (surface_state.cpp) for both
+  // directions. read_state on a surface built from the same description: the check pass
+  // (in.applying() false) changes nothing; after the apply pass spatial indexes refit everything and
+  // the spring log is forgotten (derived structures rebuild from every spring).
+  void write_state(StateWriter& out) const;
+  void read_state(StateReader& in);
+
   // ---- Solver access -------------------------------------------------------------------------
   // The solver works on the raw arrays; these are for it and for the topology code only.
   struct SolverView;
@@ -377,7 +386,8 @@ class Surface {
   void update_edge_stiffness(std::uint32_t e);
 
  private:
-  friend class WorldAccess;  // snapshots (core/scene/world_access.hpp)
+  template <class IO>
+  void state_io(IO& io);
   std::uint32_t allocate_vertex();
   std::uint32_t allocate_edge();
   std::uint32_t allocate_triangle();

@@ -225,6 +225,20 @@ class TissueWorld {
   // rolled back and reported.
   StepReport step(double dt_s);
 
+  // ---- Settling (the scene builder settles a case with other settings, then starts the clock) --
+  // Throws InvalidArgument for bad settings.
+  void replace_settings(const SolverSettings& settings);
+  // Step count and time back to zero (the settled start is time zero of the case).
+  void reset_clock();
+
+  // ---- State I/O (snapshots, core/scene/snapshot.hpp) ------------------------------------------
+  // Every bit of mutable state, each field listed once in state_io() (tissue_world_state.cpp) for
+  // both directions; surfaces list theirs in Surface::state_io.
+  void write_state(std::vector<std::uint8_t>& out) const;
+  // Reads it back into a world built from the same scene (same surfaces, capacities, attachments
+  // and forces); refuses anything that does not fit, leaving the world unchanged.
+  Status read_state(const std::uint8_t* data, std::size_t size);
+
   // ---- Inspection -----------------------------------------------------------------------------
   std::uint32_t surface_count() const { return static_cast<std::uint32_t>(surfaces_.size()); }
   Surface& surface(std::uint32_t i) { return *surfaces_.at(i); }
@@ -263,7 +277,8 @@ class TissueWorld {
   std::uint32_t total_blocks() const;
 
  private:
-  friend class WorldAccess;  // snapshots and settling (core/scene/world_access.hpp)
+  template <class IO>
+  void state_io(IO& io);
   struct Attachment {
     AttachmentDescription d;
     VertexId a, b;

@@ -7,7 +7,7 @@
 namespace vitreo::core {
 
 SidewaysBlade::SidewaysBlade(Cutter& cutter, double edge_length_mm, double stroke_length_mm)
-    : cutter_(cutter), edge_length_mm_(edge_length_mm), stroke_length_mm_(stroke_length_mm) {
+    : incision_(cutter), edge_length_mm_(edge_length_mm), stroke_length_mm_(stroke_length_mm) {
   require_range(edge_length_mm, 1e-3, 10.0, "sideways blade: edge_length_mm");
   require_range(stroke_length_mm, 1e-3, 10.0, "sideways blade: stroke_length_mm");
 }
@@ -24,28 +24,30 @@ CutResult SidewaysBlade::move_to(const Vec3& tip, const Vec3& direction) {
   }
   cur_tip_ = tip;
   cur_dir_ = direction.normalized();
-  if (!has_last_) {
+  if (has_last_ && (cur_tip_ - last_tip_).norm() < stroke_length_mm_) return r;
+  r = incision_.advance(edge_at(cur_tip_, cur_dir_));
+  if (r.status) {
     has_last_ = true;
     last_tip_ = cur_tip_;
-    last_dir_ = cur_dir_;
-    return r;
-  }
-  if ((cur_tip_ - last_tip_).norm() < stroke_length_mm_) return r;
-  return end_stroke();
-}
-
-CutResult SidewaysBlade::end_stroke() {
-  CutResult r;
-  if (!has_last_ || (cur_tip_ - last_tip_).norm() < 1e-9) return r;
-  r = cutter_.sweep(edge_at(last_tip_, last_dir_), edge_at(cur_tip_, cur_dir_));
-  if (r.status) {
-    last_tip_ = cur_tip_;
-    last_dir_ = cur_dir_;
   }
   return r;
 }
 
-Scissors::Scissors(Cutter& cutter, double blade_length_mm) : cutter_(cutter), blade_length_mm_(blade_length_mm) {
+CutResult SidewaysBlade::end_stroke() {
+  CutResult r;
+  if (!has_last_) return r;
+  if ((cur_tip_ - last_tip_).norm() > 0.0) r = incision_.advance(edge_at(cur_tip_, cur_dir_));
+  r.add(incision_.end());
+  has_last_ = false;
+  return r;
+}
+
+CutResult SidewaysBlade::lift() {
+  has_last_ = false;
+  return incision_.end();
+}
+
+Scissors::Scissors(Cutter& cutter, double blade_length_mm) : upper_(cutter), lower_(cutter), blade_length_mm_(blade_length_mm) {
   require_range(blade_length_mm, 1e-2, 20.0, "scissors: blade_length_mm");
 }
 
@@ -64,24 +66,34 @@ CutResult Scissors::set_pose(const Vec3& pivot, const Vec3& bisector, const Vec3
   }
   const Vec3 ux = u.normalized(), w = n.cross(ux);
   auto tip = [&](double angle) { return Vec3(pivot + blade_length_mm_ * (std::cos(angle) * ux + std::sin(angle) * w)); };
-  if (has_last_ && opening < last_opening_ - 1e-9) {
-    const double a0 = 0.5 * last_opening_, a1 = 0.5 * opening;
-    r = cutter_.sweep_pivot(pivot, tip(a0), tip(a1));
-    if (r.status) {
-      const CutResult r2 = cutter_.sweep_pivot(pivot, tip(-a0), tip(-a1));
-      if (!r2.status) return r2;
-      r.end_points += r2.end_points;
-      r.springs_split += r2.springs_split;
-      r.springs_opened += r2.springs_opened;
-      r.vertices_added += r2.vertices_added;
-      r.snapped += r2.snapped;
-      r.collapsed += r2.collapsed;
-      r.unresolved += r2.unresolved;
-      r.removed_mass_g += r2.removed_mass_g;
-    }
+  const double half = 0.5 * opening;
+  const bool closing = has_last_ && opening < last_opening_ - 1e-9;
+  if (!closing) {
+    // Opening, or moved without closing: what was cut stays cut; a new cut starts at this pose.
+    r.add(upper_.end());
+    r.add(lower_.end());
+  }
+  r.add(upper_.advance_pivot(pivot, tip(half)));
+  r.add(lower_.advance_pivot(pivot, tip(-half)));
+  if (opening <= 1e-9) {  // the blades have met: the cut between them is complete
+    r.add(upper_.end());
+    r.add(lower_.end());
   }
   has_last_ = true;
   last_opening_ = opening;
+  return r;
+}
+
+Status Scissors::set_blade_length(double blade_length_mm) {
+  if (!(blade_length_mm >= 1e-2 && blade_length_mm <= 20.0)) return Status::error("scissors: blade_length_mm outside [0.01, 20]");
+  blade_length_mm_ = blade_length_mm;
+  return Status::ok();
+}
+
+CutResult Scissors::release() {
+  CutResult r = upper_.end();
+  r.add(lower_.end());
+  has_last_ = false;
   return r;
 }
 

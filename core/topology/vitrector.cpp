@@ -3,21 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/common/units.hpp"
 #include "core/common/prefault.hpp"
 #include "core/common/validate.hpp"
 
 namespace vitreo::core {
 
 void VitrectorSettings::validate() const {
+  require_range(suction_pa, 0.0, 1e5, "vitrector: suction_pa");
   require_range(field_radius_mm, 0.01, 20.0, "vitrector: field_radius_mm");
   require_range(removal_radius_mm, 0.005, field_radius_mm, "vitrector: removal_radius_mm");
-  require_range(coupling, 0.0, 1.0, "vitrector: coupling");
+  require_range(max_cut_rate_cpm, 0.0, 1e5, "vitrector: max_cut_rate_cpm");
+  require_range(cut_rate_cpm, 0.0, max_cut_rate_cpm, "vitrector: cut_rate_cpm");
   require_range(leaving_damping_per_s, 0.0, 1e4, "vitrector: leaving_damping_per_s");
   require_range(snap_fraction, 0.0, 0.25, "vitrector: snap_fraction");
   require_range(min_piece_mm, 0.0, 1.0, "vitrector: min_piece_mm");
-  require_range(max_vacuum_mmhg, 0.0, 760.0, "vitrector: max_vacuum_mmhg");
-  require_range(max_cut_rate_cpm, 0.0, 1e5, "vitrector: max_cut_rate_cpm");
   quality.validate();
 }
 
@@ -41,14 +40,6 @@ Status Vitrector::set_pose(const Vec3& port, const Vec3& direction) {
   port_ = port;
   dir_ = direction.normalized();
   posed_ = true;
-  return Status::ok();
-}
-
-Status Vitrector::set_vacuum(double mmhg) {
-  if (!std::isfinite(mmhg) || mmhg < 0.0 || mmhg > settings_.max_vacuum_mmhg) {
-    return Status::error("vitrector: vacuum must be finite and in [0, max_vacuum_mmhg]");
-  }
-  vacuum_mmhg_ = mmhg;
   return Status::ok();
 }
 
@@ -77,8 +68,6 @@ VitrectorStepResult Vitrector::apply(double dt) {
   }
   Surface& s = surface_;
   const double R = settings_.field_radius_mm;
-  const double p_port = units::mmhg_to_pa(vacuum_mmhg_) * settings_.coupling;
-  const double drag = s.material().drag_pa_s_per_mm;
   const double k_leave = settings_.leaving_damping_per_s;
   samples_.clear();
   index_.for_each_in_box(Vec3(port_.array() - R), Vec3(port_.array() + R), [&](std::uint32_t v) {
@@ -89,21 +78,18 @@ VitrectorStepResult Vitrector::apply(double dt) {
     const double dist = std::sqrt(dist2);
     const double along = d.dot(dir_);
     if (along <= 0.0 || !(dist > 1e-9)) return;  // behind the port, or at its centre
+    if (!(s.mass(v) > 0.0)) return;
     const Vec3 toward = -d / dist;
-    const double cos_angle = along / dist;
-    const double falloff = (1.0 - dist / R) * (1.0 - dist / R);
-    const double m = s.mass(v), area = s.vertex_rest_area(v);
-    if (!(m > 0.0)) return;
-    const double c = drag * area / m;
-    // Attraction under implicit drag: the speed it can add is bounded by the terminal speed.
-    Vec3 a = toward * (p_port * cos_angle * falloff * area / m / (1.0 + dt * c));
-    // Leaving the field: an opposing (implicit) damping of the outward speed.
+    // Leaving the field: an opposing (implicit) damping of the outward speed. Every vertex in the
+    // field gets a sample, damped or not: applying it wakes the vertex. (The zero carries the
+    // direction's signs, as the removed attraction term's did, so recorded sessions replay bit for bit.)
+    Vec3 a = toward * 0.0;
     const double outward = -s.velocity(v).dot(toward);
     if (outward > 0.0 && k_leave > 0.0) a += toward * (outward * k_leave / (1.0 + dt * k_leave));
     samples_.push_back({v, a});
   });
-  r.attracted = static_cast<std::uint32_t>(samples_.size());
-  if (p_port > 0.0 || k_leave > 0.0) r.status = apply_external_accelerations(s, samples_, dt);
+  r.in_field = static_cast<std::uint32_t>(samples_.size());
+  if (k_leave > 0.0) r.status = apply_external_accelerations(s, samples_, dt);
   if (!r.status) return r;
   // The guillotine: cut_rate cuts per minute, each removing what has entered the port.
   if (cut_rate_cpm_ > 0.0) {

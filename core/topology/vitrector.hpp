@@ -1,24 +1,24 @@
 #pragma once
-// The vitrector (suction cutter): suction draws tissue to the port, the guillotine cutter removes
+// The vitrector (suction cutter), one model with one parameter set (VitrectorSettings) in one unit
+// per quantity (mm, Pa, cuts per minute). Suction draws tissue to the port; the guillotine removes
 // what has entered it (thesis ch. 2.6.2.3, without its clamped tiny masses).
 //
-// Call apply(dt) once per step, before TissueWorld::step(dt), at the step boundary.
+// Suction itself is a force of the solver's step: the instruments hand the port's suction field
+// (suction_pa · vacuum inside field_radius_mm · vacuum, at least removal_radius_mm) to the
+// TissueWorld as a SuctionField (core/instruments). This class does what happens at the step
+// boundary, once per step before TissueWorld::step(dt):
 //
-// Attraction: within the field hemisphere (radius field_radius_mm in front of the port, along the
-// suction direction) each vertex is pulled toward the port by a pressure
-//     p = vacuum_pa · coupling · cos(angle to the suction axis) · (1 − d / field_radius)²
-// acting on its rest area (so a = p · area / mass), applied as a velocity change under the
-// tissue's own implicit drag (Δv = a·dt / (1 + dt·c), c = drag · area / mass): strong suction drives
-// tissue toward the port at a bounded, physical speed, without clamping. Material inside the field
-// that moves away from the port is slowed by an opposing force (leaving_damping_per_s, also
-// implicit).
+// Leaving the field: material inside the field hemisphere (radius field_radius_mm in front of the
+// port, along the suction direction) that moves away from the port is slowed by an opposing,
+// implicit damping (Δv = v_out · k·dt / (1 + k·dt), k = leaving_damping_per_s), and every vertex in
+// the field is woken.
 //
-// Removal: at every cut of the guillotine (cut_rate_cpm), the tissue inside the removal hemisphere
-// (radius removal_radius_mm, in front of the port) is clipped at its boundary — springs crossing it
-// are split where they cross (snapping onto a vertex within snap_fraction of the spring's length,
-// so no piece is smaller than that fraction of its parent triangle) — and the triangles inside are
-// removed with their mass (Surface::remove_triangle): the reported removed mass is exactly what
-// total_mass() loses.
+// Removal: at every cut of the guillotine (cut rate in cuts per minute), the tissue inside the
+// removal hemisphere (radius removal_radius_mm, in front of the port) is clipped at its boundary —
+// springs crossing it are split where they cross (snapping onto a vertex within snap_fraction of the
+// spring's length, so no piece is smaller than that fraction of its parent triangle) — and the
+// triangles inside are removed with their mass (Surface::remove_triangle): the reported removed
+// mass is exactly what total_mass() loses.
 //
 // No allocation: scratch is sized to the surface's capacity when built.
 #include <cstdint>
@@ -34,21 +34,21 @@
 namespace vitreo::core {
 
 struct VitrectorSettings {
-  double field_radius_mm = 1.5;
-  double removal_radius_mm = 0.3;
-  double coupling = 0.02;  // fraction of the port vacuum acting as attraction pressure at the port
+  double suction_pa = 300.0;        // suction pressure at the port at full vacuum (the solver's SuctionField)
+  double field_radius_mm = 1.5;     // suction hemisphere at full vacuum; the leaving damping acts in it
+  double removal_radius_mm = 0.3;   // what enters this hemisphere is cut away
+  double cut_rate_cpm = 7500.0;     // the console's cut rate, cuts per minute
+  double max_cut_rate_cpm = 10000.0;
   double leaving_damping_per_s = 50.0;
   double snap_fraction = 0.05;
   double min_piece_mm = 0.005;  // crossings closer than this to a vertex snap onto it too
-  double max_vacuum_mmhg = 650.0;
-  double max_cut_rate_cpm = 10000.0;
   QualitySettings quality;  // cleanup after each removal (quality.hpp)
   void validate() const;  // throws InvalidArgument
 };
 
 struct VitrectorStepResult {
   Status status = Status::ok();
-  std::uint32_t attracted = 0;  // vertices in the field this step
+  std::uint32_t in_field = 0;   // vertices in the field this step (damped when leaving, woken)
   bool cut = false;             // the guillotine cut this step
   std::uint32_t springs_split = 0;
   std::uint32_t triangles_removed = 0;
@@ -66,10 +66,9 @@ class Vitrector {
   // Port position and suction direction (out of the port, into the eye). Refuses non-finite values
   // and a zero direction, changing nothing.
   Status set_pose(const Vec3& port_mm, const Vec3& suction_direction);
-  Status set_vacuum(double vacuum_mmhg);   // 0..max_vacuum_mmhg
   Status set_cut_rate(double cuts_per_minute);  // 0 (cutter off)..max_cut_rate_cpm
 
-  // Attraction for this step, and removal if the guillotine cuts during it.
+  // The leaving damping for this step, and removal if the guillotine cuts during it.
   VitrectorStepResult apply(double dt_s);
   // One cut of the guillotine now (removal only), regardless of the cut rate.
   VitrectorStepResult cut_now();
@@ -87,7 +86,7 @@ class Vitrector {
   VertexIndex index_;  // the field and the removal region visit only the vertices near the port
   MeshQuality quality_;
   Vec3 port_ = Vec3::Zero(), dir_ = Vec3::UnitZ();
-  double vacuum_mmhg_ = 0.0, cut_rate_cpm_ = 0.0, cut_phase_ = 0.0;
+  double cut_rate_cpm_ = 0.0, cut_phase_ = 0.0;
   bool posed_ = false;
   double removed_mass_g_ = 0.0;
   std::vector<AccelerationSample> samples_;

@@ -15,9 +15,33 @@ CanSimDevice::CanSimDevice(Script s, std::string ifname, std::uint8_t node_id, b
              false, &error_);
 }
 
+void CanSimDevice::unplug() { manual_unplug_ = true; }
+
+void CanSimDevice::plug() {
+  if (!manual_unplug_) return;
+  manual_unplug_ = false;
+  if (!scripted_down_) {
+    emu_.reset_link();  // power-cycled: waits to be identified and configured again
+    vp_can_rx_init(&rx_);
+  }
+}
+
 void CanSimDevice::step(std::uint64_t now_us) {
   if (!sock_.is_open()) return;
+  const bool scripted = emu_.disconnected(now_us);
+  if (scripted_down_ && !scripted && !manual_unplug_) {
+    emu_.reset_link();
+    vp_can_rx_init(&rx_);
+  }
+  scripted_down_ = scripted;
   CanRxFrame f;
+  if (!plugged()) {
+    while (sock_.read(f) == 1) {
+    }  // off the bus: the host's frames go nowhere
+    std::vector<proto::Bytes> discard;
+    emu_.step(now_us, discard);  // time goes on for an unplugged device
+    return;
+  }
   while (sock_.read(f) == 1) {
     vp_message m{};
     std::uint8_t node = 0;

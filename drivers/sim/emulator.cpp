@@ -1,6 +1,8 @@
 #include "drivers/sim/emulator.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -48,53 +50,78 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
     if (error) *error = "line " + std::to_string(lineno) + ": " + why;
     return false;
   };
+  constexpr double kMaxTimeMs = 1e9;     // 11 days of script time: far beyond any session
+  constexpr double kMaxValue = 1e6;      // no tracker, pedal or fixture value comes near
+  if (text.size() > (1u << 20)) return fail("a script is at most 1 MiB");
   while (std::getline(in, line)) {
     ++lineno;
     if (auto h = line.find('#'); h != std::string::npos) line.resize(h);
     std::istringstream ls(line);
-    std::string word;
-    if (!(ls >> word)) continue;
-    auto num = [&](double& v) { return static_cast<bool>(ls >> v) && std::isfinite(v); };
+    std::vector<std::string> w;
+    for (std::string t; ls >> t;) w.push_back(t);
+    if (w.empty()) continue;
+    const std::string& word = w[0];
+    // A whole token that is a finite number: "nan", "inf", "1e999", "3x" are not.
+    auto num = [&](std::size_t i, double& v) {
+      if (i >= w.size()) return false;
+      const char* b = w[i].c_str();
+      char* e = nullptr;
+      errno = 0;
+      v = std::strtod(b, &e);
+      return e != b && *e == '\0' && errno != ERANGE && std::isfinite(v);
+    };
+    auto exactly = [&](std::size_t n, const std::string& usage) {
+      return w.size() == n ? true : fail(w.size() < n ? usage : "unexpected '" + w[n] + "' after " + word);
+    };
     double a = 0, b = 0;
     if (word == "device") {
-      std::string k;
-      ls >> k;
+      if (!exactly(2, "device tracker|pedals|eyeball")) return false;
+      const std::string& k = w[1];
       if (k == "tracker") s.kind = DeviceKind::tracker;
       else if (k == "pedals") s.kind = DeviceKind::pedals;
       else if (k == "eyeball") s.kind = DeviceKind::eyeball;
       else return fail("unknown device '" + k + "' (tracker, pedals, eyeball)");
     } else if (word == "rate_hz") {
-      if (!num(a) || a < 1 || a > 10000) return fail("rate_hz must be 1..10000");
+      if (!exactly(2, "rate_hz N") || !num(1, a) || a < 1 || a > 10000) return fail("rate_hz must be 1..10000");
       s.rate_hz = static_cast<std::uint16_t>(a);
     } else if (word == "serial") {
-      if (!num(a) || a < 0 || a > 4294967295.0) return fail("serial must be a 32-bit number");
+      if (!exactly(2, "serial N") || !num(1, a) || a < 0 || a > 4294967295.0) return fail("serial must be a 32-bit number");
       s.serial = static_cast<std::uint32_t>(a);
     } else if (word == "loop" || word == "autostream") {
-      if (!num(a)) return fail(word + " needs 0 or 1");
+      if (!exactly(2, word + " 0|1") || !num(1, a) || (a != 0 && a != 1)) return fail(word + " needs 0 or 1");
       (word == "loop" ? s.loop : s.autostream) = a != 0;
     } else if (word == "tool" || word == "instrument") {
-      if (!num(a) || a < 0 || a > 255) return fail(word + " must be 0..255");
+      if (!exactly(2, word + " N") || !num(1, a) || a < 0 || a > 255) return fail(word + " must be 0..255");
       (word == "tool" ? s.tool : s.instrument) = static_cast<std::uint8_t>(a);
     } else if (word == "corrupt" || word == "drop") {
-      if (!num(a) || a < 0 || a > 1) return fail(word + " needs a probability 0..1");
+      if (!exactly(2, word + " P") || !num(1, a) || a < 0 || a > 1) return fail(word + " needs a probability 0..1");
       (word == "corrupt" ? s.corrupt_byte_prob : s.drop_frame_prob) = a;
+    } else if (word == "noise") {
+      if (!exactly(2, "noise SCALE") || !num(1, a) || a < 0 || a > 100)
+        return fail("noise needs a scale 0..100 (1: a real sensor's jitter)");
+      s.noise = a;
     } else if (word == "seed") {
-      if (!num(a) || a < 0) return fail("seed must be a non-negative number");
+      if (!exactly(2, "seed N") || !num(1, a) || a < 0 || a > 9.0e15) return fail("seed must be a non-negative number");
       s.seed = static_cast<std::uint64_t>(a);
     } else if (word == "key") {
-      if (!num(a) || a < 0) return fail("key needs a time in ms");
+      const std::size_t width = key_width(s.kind);
+      if (w.size() != width + 2)
+        return fail("key for " + std::string(to_string(s.kind)) + " needs a time and " + std::to_string(width) + " values, got " +
+                    std::to_string(w.size() - 1) + " numbers");
+      if (!num(1, a) || a < 0 || a > kMaxTimeMs) return fail("key needs a time in ms (0.." + std::to_string(static_cast<long long>(kMaxTimeMs)) + ")");
       std::vector<double> v;
-      while (num(b)) v.push_back(b);
-      if (v.size() != key_width(s.kind))
-        return fail("key for " + std::string(to_string(s.kind)) + " needs " + std::to_string(key_width(s.kind)) +
-                    " values after the time, got " + std::to_string(v.size()));
+      for (std::size_t i = 2; i < w.size(); ++i) {
+        if (!num(i, b) || std::fabs(b) > kMaxValue) return fail("key value '" + w[i] + "' is not a finite number of sane size");
+        v.push_back(b);
+      }
       if (!s.keys.empty() && static_cast<std::uint64_t>(a * 1000) <= s.keys.back().first)
         return fail("key times must increase");
       s.keys.emplace_back(static_cast<std::uint64_t>(a * 1000), std::move(v));
     } else if (word == "fault") {
       FaultEvent f;
-      std::string k;
-      if (!num(a) || !num(b) || a < 0 || b < 0 || !(ls >> k)) return fail("fault <t_ms> <duration_ms> <kind> [value]");
+      if (w.size() < 4 || w.size() > 5 || !num(1, a) || !num(2, b) || a < 0 || b < 0 || a > kMaxTimeMs || b > kMaxTimeMs)
+        return fail("fault <t_ms> <duration_ms> <kind> [value]");
+      const std::string& k = w[3];
       static const std::pair<const char*, FaultKind> kinds[] = {
           {"nan", FaultKind::nan},         {"range", FaultKind::range}, {"stuck", FaultKind::stuck},
           {"jump", FaultKind::jump},       {"version", FaultKind::version}, {"unknown", FaultKind::unknown},
@@ -105,7 +132,13 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
       if (!found) return fail("unknown fault '" + k + "'");
       f.at_us = static_cast<std::uint64_t>(a * 1000);
       f.duration_us = static_cast<std::uint64_t>(b * 1000);
-      num(f.value);
+      if (f.kind == FaultKind::jump) {
+        // How far the device clock jumps (ms); "jump nan" used to be taken as a jump of 0.
+        if (w.size() != 5 || !num(4, f.value) || std::fabs(f.value) > kMaxTimeMs)
+          return fail("fault ... jump needs how many ms the device clock jumps (a finite number)");
+      } else if (w.size() == 5) {
+        return fail("unexpected '" + w[4] + "' after fault " + k + " (only jump takes a value)");
+      }
       s.faults.push_back(f);
     } else {
       return fail("unknown directive '" + word + "'");
@@ -142,7 +175,7 @@ Script default_script(DeviceKind k) {
   return s;
 }
 
-FirmwareEmulator::FirmwareEmulator(Script s) : s_(std::move(s)), rng_(s_.seed) {
+FirmwareEmulator::FirmwareEmulator(Script s) : s_(std::move(s)), rng_(s_.seed), noise_rng_(s_.seed ^ 0x9e3779b97f4a7c15ULL) {
   streaming_ = s_.autostream;
   device_offset_us_ = 0;
 }
@@ -248,10 +281,11 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       p.timestamp_us = device_us;
       p.instrument_id = s_.instrument;
       p.tool_type = s_.tool;
-      // a little deterministic sensor noise, as a real tracker has (and the stuck detector expects)
-      std::uniform_real_distribution<float> noise(-0.002f, 0.002f);
-      for (int i = 0; i < 3; ++i) p.tip_mm[i] = static_cast<float>(v[static_cast<std::size_t>(i)]) + noise(rng_);
-      auto q = quat_from_euler_deg(v[3], v[4], v[5]);
+      // seeded sensor noise, as a real tracker has (and the stuck detector expects)
+      std::normal_distribution<double> tip(0.0, 0.005 * s_.noise), angle(0.0, 0.01 * s_.noise);
+      for (int i = 0; i < 3; ++i) p.tip_mm[i] = static_cast<float>(v[static_cast<std::size_t>(i)] + (s_.noise > 0 ? tip(noise_rng_) : 0.0));
+      const double jy = s_.noise > 0 ? angle(noise_rng_) : 0.0, jp = s_.noise > 0 ? angle(noise_rng_) : 0.0, jr = s_.noise > 0 ? angle(noise_rng_) : 0.0;
+      auto q = quat_from_euler_deg(v[3] + jy, v[4] + jp, v[5] + jr);
       for (int i = 0; i < 4; ++i) p.q_wxyz[i] = q[static_cast<std::size_t>(i)];
       p.actuation = static_cast<std::uint16_t>(std::clamp(v[6], 0.0, 1.0) * 65535.0 + 0.5);
       p.quality_pct = 98;
@@ -272,11 +306,14 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       m.type = VP_MSG_EYEBALL_STATE;
       auto& p = m.u.eyeball;
       p.timestamp_us = device_us;
-      auto q = quat_from_euler_deg(v[0], v[1], 0);
+      std::normal_distribution<double> angle(0.0, 0.01 * s_.noise), depth(0.0, 0.002 * s_.noise);
+      const double jy = s_.noise > 0 ? angle(noise_rng_) : 0.0, jp = s_.noise > 0 ? angle(noise_rng_) : 0.0, jr = s_.noise > 0 ? angle(noise_rng_) : 0.0;
+      auto q = quat_from_euler_deg(v[0] + jy, v[1] + jp, jr);
       for (int i = 0; i < 4; ++i) p.q_wxyz[i] = q[static_cast<std::size_t>(i)];
       p.port_count = 3;
       for (int i = 0; i < 3; ++i) {
         double d = std::clamp(v[2 + static_cast<std::size_t>(i)], 0.0, 40.0);
+        if (d > 0 && s_.noise > 0) d = std::max(1e-3, d + depth(noise_rng_));
         p.ports[i].flags = d > 0 ? 1 : 0;
         p.ports[i].depth_mm = d > 0 ? static_cast<float>(d) : 0.0f;
       }

@@ -34,6 +34,9 @@ struct FaultEvent {
 //                                     pedals:  axis0 axis1 switches           (axes 0..1)
 //                                     eyeball: yaw_deg pitch_deg depth0_mm depth1_mm depth2_mm (0 = no instrument)
 //   corrupt <probability per byte>    drop <probability per frame>           seed N
+//   noise <scale>                     sensor noise, 1 by default (0: none): a real tracker and fixture
+//                                     never report the same bits twice, and the driver calls a pose
+//                                     that does for 50 ms stuck
 //   fault <t_ms> <duration_ms> nan|range|stuck|jump|version|unknown|drop|disconnect [value]
 struct Script {
   DeviceKind kind = DeviceKind::tracker;
@@ -48,6 +51,10 @@ struct Script {
   double corrupt_byte_prob = 0;
   double drop_frame_prob = 0;
   std::uint64_t seed = 1;
+  // Gaussian sensor noise, times this scale: tracker tip 5 µm and orientation 0.01° (1 σ, a good
+  // optical tracker's jitter), eyeball fixture orientation 0.01° and port depth 2 µm. Pedals have a
+  // dead band at rest and none.
+  double noise = 1.0;
 };
 // Parses a script; on error returns false with "line N: reason".
 bool parse_script(const std::string& text, Script& out, std::string* error);
@@ -93,7 +100,8 @@ class FirmwareEmulator {
 
   Script s_;
   SimCounters c_;
-  std::mt19937_64 rng_;
+  std::mt19937_64 rng_;        // faults: corruption, drops
+  std::mt19937_64 noise_rng_;  // sensor noise, a stream of its own so noise does not move the faults
   std::function<void(const vp_message&)> on_sent_;
   std::vector<vp_message> replies_;
   bool streaming_ = false;

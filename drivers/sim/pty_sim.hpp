@@ -7,26 +7,27 @@
 #include <string>
 
 #include "drivers/sim/emulator.hpp"
+#include "drivers/sim/simulated_peer.hpp"
 
 namespace vitreo::drivers::sim {
 
-class PtySimDevice {
+class PtySimDevice final : public SimulatedPeer {
  public:
   // link_path: where the symlink to the pty slave is created (replaced if present).
   PtySimDevice(Script s, std::string link_path);
-  ~PtySimDevice();
+  ~PtySimDevice() override;
   PtySimDevice(const PtySimDevice&) = delete;
   PtySimDevice& operator=(const PtySimDevice&) = delete;
 
   // Reads host commands, writes due frames (with byte corruption), handles scripted disconnects.
-  void step(std::uint64_t now_us);
+  void step(std::uint64_t now_us) override;
   // Disconnect/reconnect on demand (the test's cable pull), independent of the script.
-  void unplug();
-  void plug();
+  void unplug() override;
+  void plug() override;
   bool plugged() const { return master_ >= 0; }
   const std::string& link_path() const { return link_; }
   const std::string& slave_path() const { return slave_name_; }
-  FirmwareEmulator& emulator() { return emu_; }
+  FirmwareEmulator& emulator() override { return emu_; }
   std::uint64_t tx_overflows() const { return tx_overflows_; }
   std::uint64_t bytes_written() const { return bytes_written_; }
 

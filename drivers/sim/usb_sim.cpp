@@ -267,6 +267,15 @@ UsbSimDevice::~UsbSimDevice() {
 
 void UsbSimDevice::step(std::uint64_t now_us) {
   Impl& d = *impl_;
+  bool scripted = false;
+  {
+    std::lock_guard<std::mutex> l(d.m);
+    scripted = emu_.disconnected(now_us);
+  }
+  if (scripted != scripted_down_) {
+    scripted_down_ = scripted;
+    if (!manual_unplug_) set_present(!scripted);
+  }
   std::vector<proto::Bytes> packets;
   std::lock_guard<std::mutex> l(d.m);
   d.now_us = now_us;
@@ -285,7 +294,28 @@ void UsbSimDevice::step(std::uint64_t now_us) {
 }
 
 void UsbSimDevice::unplug() {
+  if (manual_unplug_) return;
+  manual_unplug_ = true;
+  if (!scripted_down_) set_present(false);
+}
+
+void UsbSimDevice::plug() {
+  if (!manual_unplug_) return;
+  manual_unplug_ = false;
+  if (!scripted_down_) set_present(true);
+}
+
+void UsbSimDevice::set_present(bool present) {
   Impl& d = *impl_;
+  if (present) {
+    {
+      std::lock_guard<std::mutex> l(d.m);
+      d.gone = false;
+      emu_.reset_link();
+    }
+    umockdev_testbed_uevent(d.tb, d.syspath.c_str(), "add");
+    return;
+  }
   {
     std::lock_guard<std::mutex> l(d.m);
     d.gone = true;
@@ -293,16 +323,6 @@ void UsbSimDevice::unplug() {
     d.fail_pending();
   }
   umockdev_testbed_uevent(d.tb, d.syspath.c_str(), "remove");
-}
-
-void UsbSimDevice::plug() {
-  Impl& d = *impl_;
-  {
-    std::lock_guard<std::mutex> l(d.m);
-    d.gone = false;
-    emu_.reset_link();
-  }
-  umockdev_testbed_uevent(d.tb, d.syspath.c_str(), "add");
 }
 
 std::uint64_t UsbSimDevice::reports_dropped() const {

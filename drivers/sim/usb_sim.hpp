@@ -11,14 +11,15 @@
 #include <string>
 
 #include "drivers/sim/emulator.hpp"
+#include "drivers/sim/simulated_peer.hpp"
 
 namespace vitreo::drivers::sim {
 
-class UsbSimDevice {
+class UsbSimDevice final : public SimulatedPeer {
  public:
   // Creates the testbed if needed and adds the device at bus 1, address `address`.
   UsbSimDevice(Script s, std::uint16_t pid, int address = 2);
-  ~UsbSimDevice();
+  ~UsbSimDevice() override;
   UsbSimDevice(const UsbSimDevice&) = delete;
   UsbSimDevice& operator=(const UsbSimDevice&) = delete;
 
@@ -27,12 +28,13 @@ class UsbSimDevice {
   bool ok() const { return ok_; }
   const std::string& error() const { return error_; }
 
-  // Advances the emulator and queues its frames as interrupt IN reports.
-  void step(std::uint64_t now_us);
+  // Advances the emulator and queues its frames as interrupt IN reports; a scripted disconnect
+  // unplugs the device for its duration.
+  void step(std::uint64_t now_us) override;
   // Cable pull: "remove" uevent, every URB fails with ENODEV; plug(): "add" uevent, working again.
-  void unplug();
-  void plug();
-  FirmwareEmulator& emulator() { return emu_; }
+  void unplug() override;
+  void plug() override;
+  FirmwareEmulator& emulator() override { return emu_; }
   std::uint64_t reports_dropped() const;
   std::uint64_t urbs_handled() const;
 
@@ -40,7 +42,10 @@ class UsbSimDevice {
 
  private:
   FirmwareEmulator emu_;
+  void set_present(bool present);
+
   std::unique_ptr<Impl> impl_;
+  bool manual_unplug_ = false, scripted_down_ = false;
   bool ok_ = false;
   std::string error_;
 };

@@ -18,10 +18,13 @@
 #include <vector>
 
 #include "drivers/can.hpp"
+#include "drivers/open_device.hpp"
 #include "drivers/serial.hpp"
 #include "drivers/sim/can_sim.hpp"
 #include "drivers/sim/pty_sim.hpp"
 #include "drivers/usb.hpp"
+#include "rig/app/cli_checks.hpp"
+#include "rig/files/read_text_file.hpp"
 
 namespace {
 
@@ -30,8 +33,10 @@ using namespace vitreo::drivers;
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
-// Which link to talk to: exactly one of --serial, --usb, --can.
+// Which device to talk to: a URI (--device, drivers/device_uri.hpp), or one of the shorthands
+// --serial, --usb, --can, which name the same URIs.
 struct LinkOptions {
+  std::string uri;
   std::string serial;
   std::string usb;  // tracker | pedals | eyeball
   std::string can;
@@ -41,9 +46,13 @@ struct LinkOptions {
 };
 
 void add_link_options(CLI::App* cmd, LinkOptions& o) {
-  auto* s = cmd->add_option("--serial", o.serial, "serial port (or the link a simulator created)");
-  auto* u = cmd->add_option("--usb", o.usb, "USB device kind")->check(CLI::IsMember({"tracker", "pedals", "eyeball"}));
-  auto* c = cmd->add_option("--can", o.can, "CAN interface (e.g. can0, vcan0)");
+  auto* d = cmd->add_option("--device", o.uri,
+                            "the device's URI: serial:/dev/ttyACM0, can:can0?node=5, usb:1209:7a11[/SERIAL], "
+                            "sim:tracker?transport=pty&link=PATH");
+  auto* s = cmd->add_option("--serial", o.serial, "serial port (or the link a simulator created): serial:PATH");
+  auto* u = cmd->add_option("--usb", o.usb, "USB device kind: usb:1209:7a1N")->check(CLI::IsMember({"tracker", "pedals", "eyeball"}));
+  auto* c = cmd->add_option("--can", o.can, "CAN interface (e.g. can0, vcan0): can:IF?node=N");
+  d->excludes(s)->excludes(u)->excludes(c);
   s->excludes(u)->excludes(c);
   u->excludes(c);
   cmd->add_option("--node", o.node, "CAN node id of the device (1..127)")->check(CLI::Range(1, 127));
@@ -51,39 +60,38 @@ void add_link_options(CLI::App* cmd, LinkOptions& o) {
   cmd->add_option("--baud", o.baud, "serial baud rate")->check(CLI::IsMember({115200, 230400, 460800, 921600, 1000000, 2000000}));
 }
 
-// One interface over the three drivers, enough for the tool.
-struct AnyDevice {
-  std::unique_ptr<SerialDevice> serial;
-  std::unique_ptr<UsbDevice> usb;
-  std::unique_ptr<CanDevice> can;
-  DeviceSession& session() { return serial ? serial->session() : usb ? usb->session() : can->session(); }
-  void poll(int ms) {
-    if (serial) serial->poll(ms);
-    if (usb) usb->poll(ms);
-    if (can) can->poll(ms);
-  }
-};
-
-// nullptr with a one-line reason in *why on bad options.
-std::unique_ptr<AnyDevice> open_device(const LinkOptions& o, Clock& clock, std::string* why) {
-  auto d = std::make_unique<AnyDevice>();
+// The URI the options name; empty with a one-line reason in *why.
+std::string link_uri(const LinkOptions& o, std::string* why) {
+  if (!o.uri.empty()) return o.uri;
   if (!o.serial.empty()) {
-    d->serial = std::make_unique<SerialDevice>(o.serial, clock, SessionConfig{}, o.baud);
-  } else if (!o.usb.empty()) {
-    const std::uint16_t pid = o.usb == "tracker" ? kTrackerPid : o.usb == "pedals" ? kPedalsPid : kEyeballPid;
-    d->usb = std::make_unique<UsbDevice>(kVitreoUsbVid, pid, clock);
-    if (!d->usb->init(why)) return nullptr;
-  } else if (!o.can.empty()) {
+    // A path that is not a serial port (a file, /dev/null) would never connect: say so now.
+    if (std::string bad = vitreo::app::serial_port_problem(o.serial); !bad.empty()) {
+      *why = bad;
+      return {};
+    }
+    return "serial:" + o.serial + (o.baud != 921600 ? "?baud=" + std::to_string(o.baud) : "");
+  }
+  if (!o.usb.empty()) {
+    char b[32];
+    std::snprintf(b, sizeof b, "usb:%04x:%04x", kVitreoUsbVid, o.usb == "tracker" ? kTrackerPid : o.usb == "pedals" ? kPedalsPid : kEyeballPid);
+    return b;
+  }
+  if (!o.can.empty()) {
     if (o.node < 0) {
       *why = "--can needs --node";
-      return nullptr;
+      return {};
     }
-    d->can = std::make_unique<CanDevice>(o.can, static_cast<std::uint8_t>(o.node), o.fd, clock);
-  } else {
-    *why = "give one of --serial, --usb, --can";
-    return nullptr;
+    return "can:" + o.can + "?node=" + std::to_string(o.node) + (o.fd ? "&fd=1" : "");
   }
-  return d;
+  *why = "give one of --device, --serial, --usb, --can";
+  return {};
+}
+
+// nullptr with a one-line reason in *why on bad options.
+std::unique_ptr<Device> open_link(const LinkOptions& o, Clock& clock, std::string* why) {
+  const std::string uri = link_uri(o, why);
+  if (uri.empty()) return nullptr;
+  return vitreo::drivers::open_device(uri, clock, {}, why);
 }
 
 std::string describe(const Sample& s) {
@@ -149,7 +157,7 @@ int cmd_list() {
 int cmd_watch(const LinkOptions& o, double duration_s, double print_hz, bool raw, bool identify_only) {
   SteadyClock clock;
   std::string why;
-  auto dev = open_device(o, clock, &why);
+  auto dev = open_link(o, clock, &why);
   if (!dev) {
     std::fprintf(stderr, "vitreo-devices: %s\n", why.c_str());
     return 2;
@@ -169,10 +177,10 @@ int cmd_watch(const LinkOptions& o, double duration_s, double print_hz, bool raw
   });
   if (raw) {
     auto tap = [](std::span<const std::uint8_t> b) { std::printf("rx %3zu B: %s\n", b.size(), hex(b).c_str()); };
-    if (dev->serial) dev->serial->set_raw_tap(tap);
-    if (dev->usb) dev->usb->set_raw_tap(tap);
-    if (dev->can)
-      dev->can->set_raw_tap([](const CanRxFrame& f) {
+    if (auto* serial = dynamic_cast<SerialDevice*>(dev.get())) serial->set_raw_tap(tap);
+    if (auto* usb = dynamic_cast<UsbDevice*>(dev.get())) usb->set_raw_tap(tap);
+    if (auto* can = dynamic_cast<CanDevice*>(dev.get()))
+      can->set_raw_tap([](const CanRxFrame& f) {
         std::printf("rx %s%s %08x [%2u] %s\n", f.error ? "ERR " : "", f.fd ? "FD" : "  ", f.id, f.len,
                     hex({f.data, f.len}).c_str());
       });
@@ -199,6 +207,11 @@ int cmd_watch(const LinkOptions& o, double duration_s, double print_hz, bool raw
     return 1;
   }
   std::printf("[%s] %s\n", to_string(dev->session().state()), to_string(dev->session().stats()).c_str());
+  if (dev->session().stats().frames == 0) {
+    std::fprintf(stderr, "vitreo-devices: no frame from the device in %.1f s (%s)\n", duration_s,
+                 dev->session().last_error().empty() ? "is it connected and powered?" : dev->session().last_error().c_str());
+    return 1;
+  }
   return 0;
 }
 
@@ -206,15 +219,13 @@ int cmd_simulate(const std::string& kind, const std::string& script_path, const 
                  int node, bool fd, double duration_s) {
   sim::Script s;
   if (!script_path.empty()) {
-    std::ifstream in(script_path);
-    if (!in) {
-      std::fprintf(stderr, "vitreo-devices: cannot read script %s\n", script_path.c_str());
+    const auto file = vitreo::files::read_text_file(script_path);
+    if (!file.text) {
+      std::fprintf(stderr, "vitreo-devices: script: %s\n", file.error.c_str());
       return 2;
     }
-    std::stringstream ss;
-    ss << in.rdbuf();
     std::string err;
-    if (!sim::parse_script(ss.str(), s, &err)) {
+    if (!sim::parse_script(*file.text, s, &err)) {
       std::fprintf(stderr, "vitreo-devices: %s: %s\n", script_path.c_str(), err.c_str());
       return 2;
     }
@@ -273,16 +284,17 @@ int main(int argc, char** argv) {
   double id_timeout = 2, watch_s = 1e9, watch_hz = 10, dump_s = 1e9;
   auto* identify = app.add_subcommand("identify", "connect and print the device's identity");
   add_link_options(identify, id_opts);
-  identify->add_option("--timeout-s", id_timeout, "give up after this long")->check(CLI::PositiveNumber);
+  identify->add_option("--timeout-s", id_timeout, "give up after this long")->check(vitreo::app::finite_range(0.001, 86400));
 
   auto* watch = app.add_subcommand("watch", "live view of decoded samples and link statistics");
   add_link_options(watch, watch_opts);
-  watch->add_option("--duration-s", watch_s, "stop after this long")->check(CLI::PositiveNumber);
-  watch->add_option("--print-hz", watch_hz, "samples printed per second (the rest are counted)")->check(CLI::NonNegativeNumber);
+  watch->add_option("--duration-s", watch_s, "stop after this long")->check(vitreo::app::finite_range(0.001, 1e9));
+  watch->add_option("--print-hz", watch_hz, "samples printed per second (the rest are counted)")
+      ->check(vitreo::app::finite_range(0, 100000));
 
   auto* dump = app.add_subcommand("dump", "raw frame dump (hex), with link statistics each second");
   add_link_options(dump, dump_opts);
-  dump->add_option("--duration-s", dump_s, "stop after this long")->check(CLI::PositiveNumber);
+  dump->add_option("--duration-s", dump_s, "stop after this long")->check(vitreo::app::finite_range(0.001, 1e9));
 
   std::string kind = "tracker", script, link = "/tmp/vitreo-sim-tty", sim_can;
   int sim_node = -1;
@@ -290,13 +302,12 @@ int main(int argc, char** argv) {
   double sim_s = 1e9;
   auto* simulate = app.add_subcommand("simulate", "run a simulated device (firmware emulator) over a pty or CAN");
   simulate->add_option("--device", kind, "device kind")->check(CLI::IsMember({"tracker", "pedals", "eyeball"}));
-  simulate->add_option("--script", script, "script file (see drivers/sim/emulator.hpp); default: built-in")
-      ->check(CLI::ExistingFile);
+  simulate->add_option("--script", script, "script file (see drivers/sim/emulator.hpp); default: built-in");
   simulate->add_option("--link", link, "path of the serial link to create (symlink to the pty)");
   simulate->add_option("--can", sim_can, "simulate on this CAN interface instead of a pty");
   simulate->add_option("--node", sim_node, "CAN node id")->check(CLI::Range(1, 127));
   simulate->add_flag("--fd", sim_fd, "CAN FD frames");
-  simulate->add_option("--duration-s", sim_s, "stop after this long")->check(CLI::PositiveNumber);
+  simulate->add_option("--duration-s", sim_s, "stop after this long")->check(vitreo::app::finite_range(0.001, 1e9));
 
   try {
     app.parse(argc, argv);

@@ -8,16 +8,22 @@
 // recording and checks it ends in the same state.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "rig/app/cli_checks.hpp"
+#include "rig/app/stop_signals.hpp"
+#include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/session/rig_session.hpp"
 
@@ -117,6 +123,17 @@ const char* kEyeballScript =
 
 std::string lcm_file_url(const fs::path& p) { return "file://" + p.string() + "?mode=w"; }
 
+// fsync a file:// LCM log after its writer closed it, so a stopped rig leaves its telemetry on disk.
+void sync_file(const std::string& lcm_url) {
+  if (lcm_url.rfind("file://", 0) != 0) return;
+  std::string path = lcm_url.substr(7);
+  path = path.substr(0, path.find('?'));
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
 // --display CARD[:CONNECTOR[:sbs|left|right]]
 vitreo::render::KmsOptions parse_display(const std::string& spec) {
   vitreo::render::KmsOptions o;
@@ -150,7 +167,9 @@ int main(int argc, char** argv) {
   std::string lcm_url;
   std::string replay_path;
   std::string pedal_config;
+  std::string rig_path;
   std::vector<std::string> serial_devices;
+  std::vector<std::string> sim_unplugs;
   bool realtime = false;
   bool verify_replay = true;
   bool render = true;
@@ -161,55 +180,86 @@ int main(int argc, char** argv) {
                "Default: simulated tracker, pedals and eyeball fixture over ptys peel the membrane of the case\n"
                "scenes/low_membrane_macula.toml; stereo frames, telemetry to an LCM log, the session recorded\n"
                "and then replayed to verify it. Operator commands: vitreo-cmd (LCM) or typed on this terminal."};
-  app.add_option("--duration", duration_s, "session length in seconds")->check(CLI::Range(0.01, 36000.0));
-  app.add_option("--case", case_files, "a case file (repeatable: the case list, in order; the first starts)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--cases", cases_dir, "every *.toml case in this folder, sorted (default: scenes/)")
-      ->check(CLI::ExistingDirectory);
-  app.add_option("--start", first_case, "with --cases: the file name to start with (default low_membrane_macula.toml)");
-  app.add_option("--retina-vertices", retina_vertices,
-                 "retina resolution override (0 = the case's own; default 5000 keeps up with 1 kHz on 2 cores)")
-      ->check(CLI::Range(0, 2'000'000));
-  app.add_option("--texture-size", texture_px, "fundus texture size override in pixels (0 = the case's own)")
-      ->check(CLI::Range(0, 8192));
+  auto* duration_opt = app.add_option("--duration", duration_s, "session length in seconds")
+                           ->check(vitreo::app::finite_range(0.01, 36000.0));
+  auto* case_opt = app.add_option("--case", case_files, "a case file (repeatable: the case list, in order; the first starts)")
+                       ->check(CLI::ExistingFile);
+  auto* cases_opt = app.add_option("--cases", cases_dir, "every *.toml case in this folder, sorted (default: scenes/)")
+                        ->check(CLI::ExistingDirectory);
+  auto* start_opt =
+      app.add_option("--start", first_case, "with --cases: the file name to start with (default low_membrane_macula.toml)");
+  auto* retina_opt = app.add_option("--retina-vertices", retina_vertices,
+                                    "retina resolution override (0 = the case's own; default 5000 keeps up with 1 kHz on 2 cores)")
+                         ->check(CLI::Range(0, 2'000'000));
+  auto* texture_opt = app.add_option("--texture-size", texture_px, "fundus texture size override in pixels (0 = the case's own)")
+                          ->check(CLI::Range(0, 8192));
   app.add_option("--out", out_dir, "folder for frames, the telemetry log, the recording and snapshots");
   app.add_option("--cache", cache_dir, "folder for settled case starts (default: OUT/case-cache)");
-  app.add_option("--lcm-url", lcm_url,
+  auto* lcm_opt = app.add_option("--lcm-url", lcm_url,
                  "publish telemetry live on this LCM URL (e.g. udpm://239.255.76.67:7667?ttl=0) instead of to a log");
-  app.add_option("--serial", serial_devices,
-                 "a real device instead of the simulators: KIND=PATH with KIND tracker|pedals|eyeball (repeatable)");
-  app.add_option("--pedal-config", pedal_config, "TOML pedal mapping (see rig/config/default-rig.toml)")
+  auto* rig_option = app.add_option("--rig", rig_path,
+                                    "the rig's devices from a rig file (rig/config/*.toml): each device's URI (serial:, can:, usb:,\n"
+                                    "sim:), identity and role, and the pedal mapping (default: simulated devices over ptys)")
+                         ->check(CLI::ExistingFile);
+  auto* serial_opt = app.add_option("--serial", serial_devices,
+                 "a real serial device instead of the simulators: KIND=PATH with KIND tracker|pedals|eyeball (repeatable)")
+      ->excludes(rig_option);
+  app.add_option("--sim-unplug", sim_unplugs,
+                 "simulated devices: pull NAME's cable AT seconds into the session (physics time) and plug it back FOR\n"
+                 "seconds later: NAME:AT:FOR, e.g. tracker-0:1.5:0.5 (repeatable)");
+  app.add_option("--pedal-config", pedal_config, "TOML pedal mapping (see rig/config/default-rig.toml; overrides the rig file's)")
       ->check(CLI::ExistingFile);
-  app.add_option("--replay", replay_path,
-                 "replay a recording as fast as possible (its cases come from the recording) and print its final state hash")
-      ->check(CLI::ExistingFile);
-  app.add_flag("--realtime", realtime, "ask for SCHED_FIFO, locked memory and a dedicated core for physics");
+  auto* replay_opt =
+      app.add_option("--replay", replay_path,
+                     "replay a recording as fast as possible (its cases and settings come from the recording) and print\n"
+                     "its verdict and final state hash. Exit status: 0 complete and the recorded final state reached,\n"
+                     "3 a different final state, 4 truncated, 5 corrupted (replayed up to there), 1 unreadable")
+          ->check(CLI::ExistingFile);
+  auto* realtime_opt = app.add_flag("--realtime", realtime, "ask for SCHED_FIFO, locked memory and a dedicated core for physics");
   app.add_flag("!--no-verify", verify_replay, "do not replay the recording at the end");
   app.add_flag("!--no-render", render, "no stereo frames (EGL) at all");
-  app.add_flag("--commands-from-stdin", commands_from_stdin,
+  auto* stdin_opt = app.add_flag("--commands-from-stdin", commands_from_stdin,
                "read operator commands from stdin even when it is not a terminal (a pipe, a script); when it is a\n"
-               "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X");
+               "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X,\n"
+               "pan X Y, focus F, flat, wide, invert");
   std::vector<std::string> displays;
-  app.add_option("--display", displays,
+  auto* display_opt = app.add_option("--display", displays,
                  "show the frames on a rig display through KMS: CARD[:CONNECTOR[:sbs|left|right]], e.g.\n"
                  "/dev/dri/card0:HDMI-A-1:left (repeatable: one per eyepiece display; default: first connected, side by side)");
   app.add_option("--eye-size", eye_width, "width of each eye's image in pixels (height = 4/5 of it)")
       ->check(CLI::Range(64, 4096));
+  std::string frame_ring, instructor_ring;
+  app.add_option("--frame-ring", frame_ring, "publish the stereo frames in this shared-memory ring (e.g. /vitreo-frames)");
+  app.add_option("--instructor-ring", instructor_ring,
+                 "publish the instructor's view (left eye, score, retina force, events) in this shared-memory ring\n"
+                 "(e.g. /vitreo-instructor); it is also written beside the frames as step_*_instructor.png");
+  // A replay takes its cases, resolution and length from the recording: options that would choose
+  // them are refused rather than silently ignored.
+  for (CLI::Option* o : {case_opt, cases_opt, start_opt, retina_opt, texture_opt, duration_opt, serial_opt, rig_option, lcm_opt, realtime_opt,
+                         stdin_opt, display_opt})
+    replay_opt->excludes(o);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "vitreo: %s\n", e.what());  // one line; --help lists the options
+    return 2;
   }
 
   vitreo::rig::ModelConfig model;
   try {
+    std::vector<vitreo::rig::DeviceSpec> devices;
+    if (!rig_path.empty()) {
+      vitreo::rig::RigFile rig = vitreo::rig::read_rig_file(rig_path);
+      devices = std::move(rig.devices);
+      if (rig.pedals) model.pedals = *rig.pedals;
+      spdlog::info("rig {}: {} device(s){}", rig_path, devices.size(), rig.name.empty() ? "" : " — " + rig.name);
+    }
     if (!pedal_config.empty()) {
-      std::FILE* f = std::fopen(pedal_config.c_str(), "rb");
-      std::string text;
-      char buf[4096];
-      for (std::size_t n; f && (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
-      if (f) std::fclose(f);
-      model.pedals = vitreo::rig::parse_pedal_mapping(text, pedal_config);
+      const auto file = vitreo::files::read_text_file(pedal_config);
+      if (!file.text) throw std::runtime_error("--pedal-config: " + file.error);
+      model.pedals = vitreo::rig::parse_pedal_mapping(*file.text, pedal_config);
     }
     fs::create_directories(out_dir);
     const auto out = fs::absolute(out_dir);
@@ -217,13 +267,26 @@ int main(int argc, char** argv) {
 
     if (!replay_path.empty()) {
       const auto r = vitreo::rig::replay_session(replay_path, model);
-      std::printf("replay of %s (case %s, %zu in its list)\n  %llu steps, %llu inputs, %.2f s wall (%.1fx real time)\n"
-                  "  state hash %016llx\n",
-                  replay_path.c_str(), r.case_id.c_str(), r.cases.size(), static_cast<unsigned long long>(r.steps),
-                  static_cast<unsigned long long>(r.inputs), r.wall_s, static_cast<double>(r.steps) * 1e-3 / r.wall_s,
-                  static_cast<unsigned long long>(r.state_hash));
-      for (const auto& line : r.score_lines) std::printf("  score  %s\n", line.c_str());
-      return 0;
+      std::printf("replay of %s (case %s, %zu in its list)\n  recording   %s\n"
+                  "  replayed    %llu steps, %llu inputs, %.2f s wall (%.1fx real time)\n",
+                  replay_path.c_str(), r.case_id.c_str(), r.cases.size(), r.verdict_text.c_str(),
+                  static_cast<unsigned long long>(r.steps), static_cast<unsigned long long>(r.inputs), r.wall_s,
+                  static_cast<double>(r.steps) * 1e-3 / std::max(r.wall_s, 1e-9));
+      if (r.recorded_state_hash) {
+        std::printf("  state hash  %016llx — %s the recorded final state (session ended: %s)\n",
+                    static_cast<unsigned long long>(r.state_hash), r.matches_recording() ? "identical to" : "DIFFERENT from",
+                    r.stop_reason.c_str());
+      } else {
+        std::printf("  state hash  %016llx (the recording has no final state to compare with)\n",
+                    static_cast<unsigned long long>(r.state_hash));
+      }
+      for (const auto& line : r.score_lines) std::printf("  score       %s\n", line.c_str());
+      switch (r.verdict) {
+        case vitreo::telemetry::RecordingVerdict::Truncated: return 4;
+        case vitreo::telemetry::RecordingVerdict::Corrupted: return 5;
+        case vitreo::telemetry::RecordingVerdict::Complete: return r.matches_recording() ? 0 : 3;
+      }
+      return 1;
     }
 
     // The case list: --case files in order, or a folder's cases (scenes/ by default).
@@ -249,34 +312,95 @@ int main(int argc, char** argv) {
     config.render = render;
     if (commands_from_stdin || ::isatty(STDIN_FILENO)) {
       config.command_fd = STDIN_FILENO;
-      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X — one per line\n");
+      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X pan X Y focus F flat wide invert — one per line\n");
       std::fflush(stdout);
     }
     config.eye_width = eye_width;
     config.eye_height = eye_width * 4 / 5;
     config.png_dir = (out / "frames").string();
     config.png_every_frames = 10;
+    config.frame_ring_name = frame_ring;
+    config.instructor_ring_name = instructor_ring;
     if (render) fs::create_directories(config.png_dir);
     for (const auto& d : displays) config.displays.push_back(parse_display(d));
     if (!config.displays.empty() && !render) throw std::runtime_error("--display needs rendering (drop --no-render)");
-    if (serial_devices.empty()) {
-      const std::string base = "/tmp/vitreo-" + std::to_string(::getpid());
-      config.devices = {{"tracker-0", base + "-tracker", 1, 0, ""},
-                        {"pedals", base + "-pedals", 2, 0, kPedalScript},
-                        {"eyeball", base + "-eyeball", 3, 0, kEyeballScript}};
-      // The tracker's script follows the first case's anatomy (known once it is loaded).
-      config.adapt_devices = [](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& devices) {
-        devices[0].sim_script = tool_script(c);
-      };
-    } else {
+    using vitreo::rig::DeviceRole;
+    if (!serial_devices.empty()) {
       int id = 1;
       for (const auto& spec : serial_devices) {
         const auto eq = spec.find('=');
         if (eq == std::string::npos) throw std::runtime_error("--serial expects KIND=PATH, got '" + spec + "'");
-        config.devices.push_back({spec.substr(0, eq), spec.substr(eq + 1), id++, 0, ""});
+        const std::string kind = spec.substr(0, eq), path = spec.substr(eq + 1);
+        vitreo::rig::DeviceSpec d;
+        d.name = kind;
+        if (kind == "tracker") d.role = DeviceRole::tracker;
+        else if (kind == "pedals") d.role = DeviceRole::pedals;
+        else if (kind == "eyeball") d.role = DeviceRole::eyeball;
+        else throw std::runtime_error("--serial " + spec + ": unknown device kind '" + kind + "' (tracker, pedals, eyeball)");
+        for (const auto& other : devices) {
+          if (other.name == kind) throw std::runtime_error("--serial " + spec + ": a second " + kind + " (one of each)");
+          if (other.uri == "serial:" + path) throw std::runtime_error("--serial " + spec + ": " + path + " is already the " + other.name);
+        }
+        if (const std::string why = vitreo::app::serial_port_problem(path); !why.empty())
+          throw std::runtime_error("--serial " + spec + ": " + why);
+        d.uri = "serial:" + path;
+        d.device_id = id++;
+        devices.push_back(d);
       }
+    } else if (devices.empty()) {
+      // The embedded default: the three devices simulated behind ptys.
+      devices = {{"tracker-0", DeviceRole::tracker, "sim:tracker?transport=pty", 1, 0, 0, 0, ""},
+                 {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, ""},
+                 {"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, 0, ""}};
     }
+    config.devices = devices;
+    struct Unplug {
+      std::string name;
+      std::uint64_t at_step, back_step;
+    };
+    std::vector<Unplug> unplugs;
+    for (const auto& u : sim_unplugs) {
+      const auto a = u.find(':'), b = u.rfind(':');
+      char* end = nullptr;
+      const double at = a == std::string::npos || a == b ? -1.0 : std::strtod(u.c_str() + a + 1, &end);
+      const double len = at < 0.0 ? -1.0 : std::strtod(u.c_str() + b + 1, &end);
+      const std::string name = u.substr(0, a);
+      if (!(at >= 0.0) || !(len > 0.0) || *end != '\0') throw std::runtime_error("--sim-unplug " + u + ": expected NAME:AT:FOR (seconds)");
+      const auto named = std::find_if(devices.begin(), devices.end(), [&](const auto& d) { return d.name == name; });
+      if (named == devices.end()) throw std::runtime_error("--sim-unplug " + u + ": no device named " + name);
+      if (named->uri.rfind("sim:", 0) != 0) throw std::runtime_error("--sim-unplug " + u + ": " + name + " is not simulated");
+      unplugs.push_back({name, static_cast<std::uint64_t>(std::llround(at / model.dt_s)),
+                         static_cast<std::uint64_t>(std::llround((at + len) / model.dt_s))});
+    }
+    if (!unplugs.empty()) {
+      config.on_step = [unplugs](std::uint64_t step, vitreo::rig::DeviceHub& hub) {
+        for (const auto& u : unplugs) {
+          if (step != u.at_step && step != u.back_step) continue;
+          for (std::size_t i = 0; i < hub.device_count(); ++i) {
+            if (hub.name(i) != u.name) continue;
+            step == u.at_step ? hub.unplug(i) : hub.plug(i);
+          }
+        }
+      };
+    }
+    // Simulated devices without a script of their own play the main job's scripted session; the
+    // tool tracker's script follows the first case's anatomy (known once it is loaded).
+    config.adapt_devices = [](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& specs) {
+      for (auto& d : specs) {
+        if (d.uri.rfind("sim:", 0) != 0 || !d.sim_script.empty()) continue;
+        switch (d.role) {
+          case DeviceRole::tracker:
+            if (d.channel == vitreo::rig::kToolTracker) d.sim_script = tool_script(c);
+            break;
+          case DeviceRole::pedals: d.sim_script = kPedalScript; break;
+          case DeviceRole::eyeball: d.sim_script = kEyeballScript; break;
+        }
+      }
+    };
 
+    static std::atomic<int> stop_signal{0};
+    vitreo::app::install_stop_signals(stop_signal);
+    config.stop = &stop_signal;
     spdlog::info("session: {} steps of {} ms on {} ({} cases in the list); telemetry → {}", config.steps, model.dt_s * 1e3,
                  files[static_cast<std::size_t>(model.first_case)], files.size(), config.lcm_url);
     const auto s = vitreo::rig::run_session(config);
@@ -288,7 +412,8 @@ int main(int argc, char** argv) {
     std::printf("  retina           %s vertices\n", retina_vertices > 0 ? std::to_string(retina_vertices).c_str() : "the case's");
     std::printf("  instruments      %s\n", s.instruments.c_str());
     for (const auto& line : s.cases_loaded) std::printf("  case loaded      %s\n", line.c_str());
-    std::printf("  simulated        %.3f s in %llu steps\n", s.simulated_s, static_cast<unsigned long long>(s.steps));
+    std::printf("  simulated        %.3f s in %llu steps (%s)\n", s.simulated_s, static_cast<unsigned long long>(s.steps),
+                s.stop_reason == "duration reached" ? "the whole duration" : ("stopped early by " + s.stop_reason).c_str());
     std::printf("  step time        p50 %.0f us, p99 %.0f us, max %.0f us; %llu overruns, %llu late, %llu dropped\n",
                 s.loop.step_p50_ns * 1e-3, s.loop.step_p99_ns * 1e-3, s.loop.step_max_ns * 1e-3,
                 static_cast<unsigned long long>(s.loop.overruns), static_cast<unsigned long long>(s.loop.late_steps),
@@ -297,6 +422,7 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(s.inputs_applied), static_cast<unsigned long long>(s.inputs_refused),
                 static_cast<unsigned long long>(s.inputs_recorded), static_cast<unsigned long long>(s.recorder_dropped));
     for (const auto& line : s.device_lines) std::printf("  device           %s\n", line.c_str());
+    for (const auto& line : s.fault_lines) std::printf("  sensor faults    %s\n", line.c_str());
     std::printf("  events           %llu grasps, %llu burns, %llu attachments broken, %llu tears, %llu instrument events, "
                 "%llu steps rolled back\n",
                 static_cast<unsigned long long>(s.grasps), static_cast<unsigned long long>(s.burns),
@@ -305,23 +431,30 @@ int main(int argc, char** argv) {
     std::printf("  telemetry        %llu messages (%llu dropped) → %s\n",
                 static_cast<unsigned long long>(s.telemetry_published), static_cast<unsigned long long>(s.telemetry_dropped),
                 config.lcm_url.c_str());
-    std::printf("  recording        %s\n", config.record_path.c_str());
+    for (const auto& line : s.receive_lines) std::printf("  received         %s\n", line.c_str());
+    std::printf("  recording        %s%s%s\n", config.record_path.c_str(), s.recording_problem.empty() ? "" : " — ",
+                s.recording_problem.c_str());
     for (const auto& line : s.snapshots) std::printf("  snapshot         %s\n", line.c_str());
     if (render) {
       std::printf("  frames           %llu stereo frames %dx%d per eye (%s); %zu written to %s, the last: %s\n",
                   static_cast<unsigned long long>(s.frames_rendered), config.eye_width, config.eye_height, s.renderer.c_str(),
                   s.pngs.size(), config.png_dir.c_str(), s.pngs.empty() ? "none" : (s.pngs.back() + "_stereo.png").c_str());
+      std::printf("  instructor view  %s%s\n", s.pngs.empty() ? "none" : (s.pngs.back() + "_instructor.png").c_str(),
+                  instructor_ring.empty() ? "" : (" and the shared-memory ring " + instructor_ring).c_str());
     }
     for (const auto& line : s.displays) std::printf("  display          %s\n", line.c_str());
     for (std::size_t i = 0; i < s.score_lines.size(); ++i)
       std::printf("  %s %s\n", i == 0 ? "score           " : "                ", s.score_lines[i].c_str());
     std::printf("  state hash       %016llx\n", static_cast<unsigned long long>(s.state_hash));
+    std::fflush(stdout);
+    sync_file(config.lcm_url);  // the telemetry log, when it is one (the recording synced itself)
     if (verify_replay) {
       const auto r = vitreo::rig::replay_session(config.record_path, model);
-      const bool same = r.state_hash == s.state_hash && r.score_lines == s.score_lines;
+      const bool complete = r.verdict == vitreo::telemetry::RecordingVerdict::Complete;
+      const bool same = complete && r.matches_recording() && r.state_hash == s.state_hash && r.score_lines == s.score_lines;
       std::printf("  replay           %llu steps in %.2f s (%.1fx real time), cases from the recording: %s\n",
                   static_cast<unsigned long long>(r.steps), r.wall_s, static_cast<double>(r.steps) * model.dt_s / r.wall_s,
-                  same ? "identical final state and score" : "DIFFERENT final state");
+                  same ? "identical final state and score" : complete ? "DIFFERENT final state" : r.verdict_text.c_str());
       if (!same) return 3;
     }
     return s.rolled_back == 0 ? 0 : 2;

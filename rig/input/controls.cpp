@@ -2,8 +2,11 @@
 
 #include <toml++/toml.h>
 
+#include "rig/files/toml_guard.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <stdexcept>
 
@@ -31,6 +34,14 @@ bool PedalMapper::apply(const PedalReading& r) {
   } else if (r.pedal_id == m_.microscope_pedal_id) {
     c_.zoom = m_.zoom_min + axis(m_.zoom_axis) * (m_.zoom_max - m_.zoom_min);
     c_.focus_offset_mm = (axis(m_.focus_axis) - 0.5) * m_.focus_range_mm;
+    // Joystick axes read 0.5 when absent: centred, so a two-axis pedal never drifts the field.
+    auto deflection = [&](int index) {
+      const double d = 2.0 * ((index >= 0 && index < r.axis_count ? r.axes[index] : 0.5) - 0.5);
+      const double beyond = std::max(0.0, std::abs(d) - m_.pan_deadband) / (1.0 - m_.pan_deadband);
+      return d < 0.0 ? -beyond : beyond;
+    };
+    c_.pan_x = deflection(m_.pan_x_axis);
+    c_.pan_y = deflection(m_.pan_y_axis);
     if (bit(r.switches, m_.light_up_switch) && !bit(last_switches_[1], m_.light_up_switch)) {
       c_.light_level = std::min(1.0, c_.light_level + m_.light_step);
     }
@@ -43,6 +54,9 @@ bool PedalMapper::apply(const PedalReading& r) {
 }
 
 PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string& origin) {
+  // toml++ 3.3.0 has undefined behaviour on two kinds of malformed text (rig/files/toml_guard.hpp).
+  if (const files::TomlProblem bad = files::toml_guard(toml_text))
+    throw std::runtime_error(origin + ":" + std::to_string(bad.line) + ": column " + std::to_string(bad.column) + ": " + bad.why);
   toml::table root;
   try {
     root = toml::parse(toml_text, origin);
@@ -74,6 +88,9 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
       {"zoom_min", {&m.zoom_min, nullptr, 0.1, 40}},
       {"zoom_max", {&m.zoom_max, nullptr, 0.1, 40}},
       {"focus_range_mm", {&m.focus_range_mm, nullptr, 0, 40}},
+      {"pan_x_axis", {nullptr, &m.pan_x_axis, -1, 3}},
+      {"pan_y_axis", {nullptr, &m.pan_y_axis, -1, 3}},
+      {"pan_deadband", {&m.pan_deadband, nullptr, 0, 0.9}},
       {"light_up_switch", {nullptr, &m.light_up_switch, -1, 15}},
       {"light_down_switch", {nullptr, &m.light_down_switch, -1, 15}},
       {"light_step", {&m.light_step, nullptr, 0, 1}},
@@ -102,6 +119,23 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
     }
   }
   if (m.zoom_max < m.zoom_min) throw std::runtime_error(origin + ": pedals.zoom_max is below zoom_min");
+  // One switch or axis doing two jobs on the same pedal would fire both at once (reflux with every
+  // laser shot): refused, with both names. -1 means "none" and may repeat.
+  auto distinct = [&](const char* what, std::initializer_list<std::pair<const char*, int>> uses) {
+    for (auto a = uses.begin(); a != uses.end(); ++a) {
+      for (auto b = a + 1; b != uses.end(); ++b) {
+        if (a->second >= 0 && a->second == b->second)
+          throw std::runtime_error(origin + ": pedals." + a->first + " and pedals." + b->first + " are the same " + what + " (" +
+                                   std::to_string(a->second) + ")");
+      }
+    }
+  };
+  distinct("switch", {{"reflux_switch", m.reflux_switch}, {"laser_switch", m.laser_switch},
+                      {"instrument_switch", m.instrument_switch}, {"air_switch", m.air_switch}});
+  distinct("axis", {{"vacuum_axis", m.vacuum_axis}, {"cut_rate_axis", m.cut_rate_axis}});
+  distinct("switch", {{"light_up_switch", m.light_up_switch}, {"light_down_switch", m.light_down_switch}});
+  distinct("axis", {{"zoom_axis", m.zoom_axis}, {"focus_axis", m.focus_axis}});
+  distinct("pedal id", {{"vitrectomy_pedal_id", m.vitrectomy_pedal_id}, {"microscope_pedal_id", m.microscope_pedal_id}});
   if (m.cut_rate_max_cpm < m.cut_rate_min_cpm) throw std::runtime_error(origin + ": pedals.cut_rate_max_cpm is below cut_rate_min_cpm");
   return m;
 }

@@ -3,7 +3,7 @@
 //
 // The vitrectomy pedal's travel sets vacuum (and, on dual-linear pedals, its side travel the cut
 // rate); its switches fire the laser, reflux, and change instrument. The microscope pedal sets zoom,
-// focus and light. Which axis or switch does what is configuration, since rigs differ
+// focus, the X–Y joystick and light. Which axis or switch does what is configuration, since rigs differ
 // (rig/config/default-rig.toml).
 #include <cstdint>
 #include <string>
@@ -27,7 +27,12 @@ struct PedalMapping {
   int focus_axis = 1;
   double zoom_min = 1.0;
   double zoom_max = 4.0;
-  double focus_range_mm = 6.0;  // focus travels ±half of this about the working plane
+  double focus_range_mm = 6.0;  // focus travels ±half of this about the fundus
+  // The X–Y joystick: two axes, 0.5 = centred (a pedal without them leaves the microscope still),
+  // deflection beyond the dead band moves the field at a speed (core::Microscope).
+  int pan_x_axis = 2;
+  int pan_y_axis = 3;
+  double pan_deadband = 0.08;  // of the half travel
   int light_up_switch = 0;
   int light_down_switch = 1;
   double light_step = 0.1;
@@ -42,6 +47,7 @@ struct SurgicalControls {
   bool air_infusion = false;             // the infusion runs air (fluid–air exchange), toggled by air_switch
   double zoom = 1.0;
   double focus_offset_mm = 0.0;
+  double pan_x = 0.0, pan_y = 0.0;  // joystick −1..1 (+x image right, +y image up), dead band removed
   double light_level = 0.7;  // 0..1 of the light source
 };
 

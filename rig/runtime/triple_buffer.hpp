@@ -4,13 +4,16 @@
 // to read, and the third slot is swapped atomically between them. This is the thesis' double-buffered
 // vertex state (ch. 2.3.2) made wait-free: a slow reader sees fewer updates, never a torn one, and
 // never holds back the writer. Same idea as PX4 uORB's "latest sample" topics and the classic
-// triple-buffering of graphics swap chains.
+// triple-buffering of graphics swap chains. The one latest-value mailbox of the rig: device samples
+// to physics, view snapshots to the picture, scenes to the render thread, command context to the
+// telemetry thread.
 #include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <new>
 #include <type_traits>
+#include <utility>
 
 namespace vitreo::runtime {
 
@@ -28,13 +31,15 @@ class TripleBuffer {
   T& write_slot() noexcept { return slots_[back_].value; }
   // Makes the filled slot the latest; the writer gets the previously shared slot back.
   void publish() noexcept {
-    back_ = static_cast<std::uint8_t>(middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh),
-                                                       std::memory_order_acq_rel) &
-                                      kIndexMask);
+    const std::uint8_t previous =
+        middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
+    if (previous & kFresh) dropped_.fetch_add(1, std::memory_order_relaxed);  // the reader never took it
+    back_ = static_cast<std::uint8_t>(previous & kIndexMask);
     publishes_.fetch_add(1, std::memory_order_relaxed);
   }
-  void write(const T& v) {
-    write_slot() = v;
+  // Copies (or moves) a whole value in and publishes it.
+  void write(T v) {
+    write_slot() = std::move(v);
     publish();
   }
 
@@ -51,9 +56,13 @@ class TripleBuffer {
     update();
     return read_slot();
   }
+  // The latest value if it is new since the last take()/update() (valid until the next one), else nullptr.
+  const T* take() noexcept { return update() ? &read_slot() : nullptr; }
 
   // Total publishes so far (any thread; for statistics only).
   std::uint64_t publishes() const noexcept { return publishes_.load(std::memory_order_relaxed); }
+  // Values overwritten before the reader took them (any thread; statistics).
+  std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
 
  private:
   static constexpr std::uint8_t kIndexMask = 0x3;
@@ -67,6 +76,7 @@ class TripleBuffer {
   alignas(64) std::uint8_t back_ = 0;   // writer-owned
   alignas(64) std::uint8_t front_ = 2;  // reader-owned
   alignas(64) std::atomic<std::uint64_t> publishes_{0};
+  std::atomic<std::uint64_t> dropped_{0};
 };
 
 }  // namespace vitreo::runtime

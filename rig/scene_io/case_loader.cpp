@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/scene/snapshot.hpp"
+#include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/scene_file.hpp"
 
 namespace vitreo::scene_io {
@@ -16,12 +17,6 @@ namespace {
 // tears clean up after themselves, core/topology/clean_topology.hpp).
 constexpr int kBuilderVersion = 2;
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 0xcbf29ce484222325ULL) {
   for (unsigned char c : s) {
@@ -34,11 +29,13 @@ std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 0xcbf29ce484222325UL
 }  // namespace
 
 CaseText read_case_text(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw SceneError(path, 0, "", "no such scene file");
+  // A regular file of at most 1 MiB: not a directory ("no such scene file" was wrong for one), not
+  // a device or a FIFO, not 100 MB that would be carried into every recording.
+  files::TextFile f = files::read_text_file(path);
+  if (!f.text) throw SceneError(path, 0, "", f.error);
   CaseText c;
   c.file_name = path;
-  c.text = slurp(path);
+  c.text = std::move(*f.text);
   // Parsing reads the library the case names (relative to it) and tells us its text.
   (void)parse_scene(c.text, path, nullptr, &c.library_text);
   return c;

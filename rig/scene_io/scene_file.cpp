@@ -15,6 +15,9 @@
 
 #include <toml++/toml.h>
 
+#include "rig/files/read_text_file.hpp"
+#include "rig/files/toml_guard.hpp"
+
 namespace vitreo::scene_io {
 
 namespace {
@@ -89,6 +92,12 @@ class Tab {
     if (!n) return;
     if (!n->is_string()) fail(k, "expected a string");
     out = n->as_string()->get();
+  }
+  void boolean(const std::string& k, bool& out) {
+    const toml::node* n = get(k);
+    if (!n) return;
+    if (!n->is_boolean()) fail(k, "expected true or false");
+    out = n->as_boolean()->get();
   }
   std::string required_string(const std::string& k) {
     if (!has(k)) fail("", "missing key '" + k + "'");
@@ -167,6 +176,9 @@ void validated(const Tab& t, F&& f) {
 }
 
 toml::table parse_toml(std::string_view text, const std::string& file) {
+  // toml++ 3.3.0 has undefined behaviour on two kinds of malformed text (rig/files/toml_guard.hpp).
+  if (const files::TomlProblem bad = files::toml_guard(text))
+    throw SceneError(file, bad.line, "", "column " + std::to_string(bad.column) + ": " + bad.why);
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {
@@ -174,14 +186,11 @@ toml::table parse_toml(std::string_view text, const std::string& file) {
   }
 }
 
+// A regular file of at most 1 MiB (`library = "/dev/zero"` grew a process to gigabytes).
 std::string read_file(const std::string& path, const std::string& from_file, int from_line, const std::string& key) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw SceneError(from_file, from_line, key, "cannot read '" + path + "'");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  const std::string s = ss.str();
-  if (s.size() > (1u << 20)) throw SceneError(from_file, from_line, key, "'" + path + "' is larger than 1 MiB");
-  return s;
+  files::TextFile f = files::read_text_file(path);
+  if (!f.text) throw SceneError(from_file, from_line, key, f.error);
+  return std::move(*f.text);
 }
 
 // ---- Materials -----------------------------------------------------------------------------------
@@ -482,6 +491,24 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     });
     d.criteria.push_back(s);
   }
+  if (auto t = root.table("view")) {
+    if (t->has("region_of_interest")) d.view.region_of_interest = t->location("region_of_interest");
+    std::string stain = core::to_string(d.view.gel_stain);
+    t->string("gel_stain", stain);
+    if (stain == "none") d.view.gel_stain = core::GelStain::kClear;
+    else if (stain == "triamcinolone") d.view.gel_stain = core::GelStain::kTriamcinolone;
+    else t->fail("gel_stain", "must be \"none\" or \"triamcinolone\"");
+    t->boolean("wide_angle", d.view.wide_angle);
+    t->boolean("chandelier", d.view.chandelier);
+    t->finish();
+    validated(*t, [&] {
+      core::SceneDescription probe;
+      probe.name = "probe";
+      probe.anatomy = d.anatomy;
+      probe.view = d.view;
+      probe.validate();
+    });
+  }
   if (auto t = root.table("settle")) {
     t->integer("max_steps", d.settle.max_steps, 0, 20000);
     t->integer("min_steps", d.settle.min_steps, 0, 20000);
@@ -502,8 +529,7 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
 }
 
 core::SceneDescription load_scene_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw SceneError(path, 0, "", "no such scene file");
+  // read_file says which it is: no such file, a directory, a device, over 1 MiB.
   return parse_scene(read_file(path, path, 0, ""), path);
 }
 

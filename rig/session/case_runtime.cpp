@@ -15,14 +15,21 @@ core::Vec3 on_wall(const core::EyeModel& eye, const core::FundusLocation& at) {
   return eye.wall_point(at.polar_deg * kDeg, at.azimuth_deg * kDeg);
 }
 
-// Where the surgeon will look first: the pathology the case is about.
+// Where the surgeon will look first: the case's own choice, else the pathology it is about.
 core::Vec3 region_of_interest(const core::Scene& s) {
   const auto& d = s.description;
+  if (d.view.region_of_interest) return on_wall(s.eye, *d.view.region_of_interest);
   if (!d.tears.empty()) return on_wall(s.eye, d.tears.front().center);
   if (!d.membranes.empty()) return on_wall(s.eye, d.membranes.front().center);
   if (!d.detachments.empty()) return on_wall(s.eye, d.detachments.front().center);
   for (const auto& g : d.guides) {
-    if (!g.points.empty()) return on_wall(s.eye, g.points.front());
+    if (!g.points.empty()) {
+      // The middle of the path, so the whole of it is in the field.
+      core::Vec3 sum = core::Vec3::Zero();
+      for (const auto& p : g.points) sum += on_wall(s.eye, p);
+      const core::Vec3 mean = sum / static_cast<double>(g.points.size());
+      return s.eye.wall.radius_toward(mean) * mean.normalized();
+    }
     if (g.around.empty()) return on_wall(s.eye, g.center);
   }
   return s.eye.fovea_mm;
@@ -120,10 +127,11 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   }
   std::vector<std::uint32_t> surfaces;
   for (std::uint32_t i = 0; i < s.world.surface_count(); ++i) surfaces.push_back(i);
-  out->topology = std::make_unique<core::TopologyAdapter>(s.world, surfaces, surfaces);
-  out->system = std::make_unique<core::InstrumentSystem>(s.world, o, instruments);
-  out->system->set_topology(out->topology.get());
-  out->metrics = std::make_unique<core::SessionMetrics>(s, out->system.get());
+  out->topology = std::make_unique<core::TopologyAdapter>(s.world, surfaces, surfaces, core::CutSettings{}, o.vitrector);
+  out->sim = std::make_unique<core::Simulation>(s.world, o, instruments);
+  out->sim->set_topology(out->topology.get());
+  out->metrics = std::make_unique<core::SessionMetrics>(s, out->sim.get());
+  out->sim->set_observer(out->metrics.get());  // the step's last stage
   return out;
 }
 

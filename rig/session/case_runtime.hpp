@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "core/instruments/instrument_system.hpp"
 #include "core/instruments/topology_adapter.hpp"
 #include "core/metrics/session_metrics.hpp"
+#include "core/sim/simulation.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "rig/input/port_pivot.hpp"
 #include "rig/scene_io/case_loader.hpp"
@@ -35,12 +35,12 @@ struct PreparedCase {
   int index = 0;  // in the session's case list
   std::unique_ptr<core::Scene> scene;
   std::unique_ptr<core::TopologyAdapter> topology;
-  std::unique_ptr<core::InstrumentSystem> system;
-  // The case's metrics, criteria and scores (core/metrics), observed after every step; built with
-  // the case so a switch swaps them with it and nothing allocates on the physics thread.
+  std::unique_ptr<core::Simulation> sim;
+  // The case's metrics, criteria and scores (core/metrics), the simulation step's last stage; built
+  // with the case so a switch swaps them with it and nothing allocates on the physics thread.
   std::unique_ptr<core::SessionMetrics> metrics;
-  std::vector<core::InstrumentKind> tools;  // system instruments 0..tools.size()-1
-  int light_pipe = -1;                      // system instrument index of the light pipe (-1: none)
+  std::vector<core::InstrumentKind> tools;  // simulation instruments 0..tools.size()-1
+  int light_pipe = -1;                      // simulation instrument index of the light pipe (-1: none)
   Port tracker_ports[kTrackedInstruments];  // pivot of each tracked instrument
   core::Vec3 focus_mm = core::Vec3::Zero(); // the case's region of interest (light, microscope)
   std::uint64_t start_hash = 0;             // world state hash at the settled start
@@ -53,6 +53,7 @@ struct PreparedCase {
   const CaseVisuals* visuals = nullptr;
   std::vector<ViewSnapshot> spare_views;
   std::size_t spare_views_used = 0;
+  double view_measured_at_s = -1e300;  // case time capture_view last measured the criteria for the picture
 };
 
 // The instrument kind of a scene file's instrument name; false for those that are not tracked

@@ -5,7 +5,12 @@
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
+#include <variant>
 
+#include <unistd.h>
+
+#include "drivers/open_device.hpp"
+#include "drivers/sim/simulated_peer.hpp"
 #include "rig/session/device_inputs.hpp"
 #include "rig/session/simulation_model.hpp"
 
@@ -15,36 +20,56 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
   for (auto& spec : specs) {
     auto d = std::make_unique<Device>();
     d->spec = spec;
-    if (!spec.sim_script.empty()) {
-      drivers::sim::Script script;
-      std::string error;
-      if (!drivers::sim::parse_script(spec.sim_script, script, &error)) {
-        throw std::runtime_error("device " + spec.name + ": bad simulation script: " + error);
-      }
-      d->sim = std::make_unique<drivers::sim::PtySimDevice>(script, spec.serial_path);
-    }
-    d->driver = std::make_unique<drivers::SerialDevice>(spec.serial_path, clock_);
+    drivers::OpenOptions options;
+    // the device at this address must be the kind its role says (and the serial, when given)
+    options.session.expected_device_type = spec.role == DeviceRole::tracker  ? VP_DEVICE_TRACKER
+                                           : spec.role == DeviceRole::pedals ? VP_DEVICE_PEDAL
+                                                                             : VP_DEVICE_EYEBALL;
+    options.session.expected_serial = spec.expected_serial;
+    if (spec.sample_rate_hz > 0) options.session.sample_rate_hz = spec.sample_rate_hz;
+    options.sim_script = spec.sim_script;
+    options.sim_link = "/tmp/vitreo-" + std::to_string(::getpid()) + "-" + spec.name;
+    std::string error;
+    d->driver = drivers::open_device(spec.uri, clock_, options, &error);
+    if (!d->driver) throw std::runtime_error("device " + spec.name + ": " + error);
     Device* raw = d.get();
-    d->driver->session().set_on_sample([this, raw](const drivers::Sample& s) {
-      telemetry::DeviceInput in = encode_sample(s, raw->spec.device_id, raw->sequence++);
-      in.channel = raw->spec.channel;
-      raw->latest.write_slot() = in;
-      raw->latest.publish();
-    });
-    d->driver->session().set_on_state([this, raw](drivers::LinkState from, drivers::LinkState to, const char* why) {
-      spdlog::info("device {}: {} -> {} ({})", raw->spec.name, drivers::to_string(from), drivers::to_string(to), why ? why : "");
-      const bool up = to == drivers::LinkState::streaming;
-      const bool down = to == drivers::LinkState::lost;
-      if (!up && !down) return;
+    // A link change as a recorded input: values[0] the LinkInput, values[1] the device's type (from
+    // its DEVICE_INFO, 0 before one came) — only a tracker's link freezes an instrument.
+    auto link_input = [this, raw](LinkInput state) {
       telemetry::DeviceInput link;
       link.device_id = raw->spec.device_id;
       link.device_kind = kLinkKind;
       link.channel = raw->spec.channel;
       link.host_time_us = static_cast<std::int64_t>(clock_.now_us());
       link.sequence = raw->sequence++;
-      link.n_values = 1;
-      link.values[0] = static_cast<double>(up ? LinkInput::Up : LinkInput::Lost);
+      link.n_values = 2;
+      link.values[0] = static_cast<double>(state);
+      const auto& session = raw->driver->session();
+      link.values[1] = session.has_device_info() ? static_cast<double>(session.device_info().device_type) : 0.0;
       if (!links_.try_push(link)) spdlog::warn("device {}: link-change queue full, change dropped", raw->spec.name);
+    };
+    d->driver->session().set_on_sample([this, raw, link_input](const drivers::Sample& s) {
+      telemetry::DeviceInput in = encode_sample(s, raw->spec.device_id, raw->sequence++);
+      in.channel = raw->spec.channel;
+      // A stuck sensor (the driver's verdict: bit-identical for 50 ms of device time) is reported at
+      // once, ahead of its sample: physics freezes the instrument as if the tracker were lost.
+      const bool stuck = std::visit([](const auto& x) { return x.stuck; }, s);
+      if (stuck != raw->stuck_reported) {
+        raw->stuck_reported = stuck;
+        if (stuck) spdlog::warn("device {}: sensor stuck (identical samples for 50 ms) — its instrument is frozen", raw->spec.name);
+        else spdlog::info("device {}: sensor moving again", raw->spec.name);
+        link_input(stuck ? LinkInput::Stuck : LinkInput::Up);
+      }
+      raw->latest.write_slot() = in;
+      raw->latest.publish();
+    });
+    d->driver->session().set_on_state([raw, link_input](drivers::LinkState from, drivers::LinkState to, const char* why) {
+      spdlog::info("device {}: {} -> {} ({})", raw->spec.name, drivers::to_string(from), drivers::to_string(to), why ? why : "");
+      const bool up = to == drivers::LinkState::streaming;
+      const bool down = to == drivers::LinkState::lost;
+      if (!up && !down) return;
+      raw->stuck_reported = false;  // a new link starts unstuck (the driver forgets too)
+      link_input(up ? LinkInput::Up : LinkInput::Lost);
     });
     devices_.push_back(std::move(d));
   }
@@ -69,15 +94,16 @@ void DeviceHub::plug(std::size_t device) { devices_.at(device)->plug_request.sto
 
 void DeviceHub::run_sims() {
   // The emulators stand in for the devices' own firmware: they run on their own thread, in real
-  // time, and the drivers know nothing about them beyond the bytes on the pty.
+  // time, and the drivers know nothing about them beyond the bytes on their transport.
   while (running_.load(std::memory_order_acquire)) {
     const std::uint64_t now = clock_.now_us();
     for (auto& d : devices_) {
-      if (!d->sim) continue;
+      drivers::sim::SimulatedPeer* peer = d->driver->simulated_peer();
+      if (!peer) continue;
       const int request = d->plug_request.exchange(0);
-      if (request < 0) d->sim->unplug();
-      if (request > 0) d->sim->plug();
-      d->sim->step(now);
+      if (request < 0) peer->unplug();
+      if (request > 0) peer->plug();
+      peer->step(now);
     }
     std::this_thread::sleep_for(std::chrono::microseconds(250));
   }
@@ -85,7 +111,17 @@ void DeviceHub::run_sims() {
 
 void DeviceHub::run_drivers() {
   std::uint64_t next_status = 0;
+  std::uint64_t last_pass = 0;
   while (running_.load(std::memory_order_acquire)) {
+    // A pass normally follows the last within ~0.3 ms; a long gap means this thread was starved
+    // (a loaded machine): the devices' bytes piled up in the kernel meanwhile.
+    const std::uint64_t pass = clock_.now_us();
+    if (last_pass != 0 && pass - last_pass >= kReaderStallUs) {
+      reader_stalls_.fetch_add(1, std::memory_order_relaxed);
+      if (pass - last_pass > reader_stall_max_us_.load(std::memory_order_relaxed))
+        reader_stall_max_us_.store(pass - last_pass, std::memory_order_relaxed);
+    }
+    last_pass = pass;
     bool changed = false;
     for (auto& d : devices_) {
       d->driver->poll(0);
@@ -123,7 +159,7 @@ void DeviceHub::publish_status(std::uint64_t) {
     telemetry::DeviceStatus s;
     s.device_id = d->spec.device_id;
     std::strncpy(s.name, d->spec.name.c_str(), sizeof s.name - 1);
-    std::strncpy(s.transport, ("serial:" + d->spec.serial_path).c_str(), sizeof s.transport - 1);
+    std::strncpy(s.transport, d->driver->uri().c_str(), sizeof s.transport - 1);
     s.state = status_code(session.state());
     std::strncpy(s.detail, drivers::to_string(session.state()), sizeof s.detail - 1);
     s.frames_rx = static_cast<std::int64_t>(st.frames);
@@ -132,6 +168,14 @@ void DeviceHub::publish_status(std::uint64_t) {
     s.framing_errors = static_cast<std::int64_t>(st.framing_errors);
     s.sequence_gaps = static_cast<std::int64_t>(st.drops);
     s.reconnects = static_cast<std::int64_t>(st.reconnects);
+    s.stuck = session.stuck();
+    s.stuck_episodes = static_cast<std::int64_t>(st.stuck_episodes);
+    s.stuck_samples = static_cast<std::int64_t>(st.stuck_samples);
+    s.range_rejected = static_cast<std::int64_t>(st.range_rejected);
+    s.timestamp_jumps = static_cast<std::int64_t>(st.timestamp_jumps);
+    s.reader_stalls = static_cast<std::int64_t>(reader_stalls());
+    s.reader_stall_max_ms = static_cast<float>(reader_stall_max_us()) * 1e-3f;
+    if (session.stuck()) std::strncpy(s.detail, "stuck: identical samples for >= 50 ms", sizeof s.detail - 1);
     status_out_->push(s);
     d->last_state = session.state();
   }

@@ -3,7 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <algorithm>
 #include <array>
@@ -107,6 +109,10 @@ telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
   in.n_values = 2;
   in.values[0] = static_cast<double>(static_cast<int>(cmd.code));
   in.values[1] = cmd.value;
+  if (cmd.code == telemetry::CommandCode::Pan) {  // y travels as text (validated by the server)
+    in.n_values = 3;
+    in.values[2] = std::strtod(cmd.arg, nullptr);
+  }
   return in;
 }
 
@@ -153,6 +159,13 @@ std::vector<std::string> score_lines(SimulationModel& model) {
 
 SessionSummary run_session(const SessionConfig& config) {
   if (config.model.cases.empty()) throw std::invalid_argument("run_session: no case to run");
+  // spdlog's registry (the default logger) is a function-local static inside Debian's libspdlog,
+  // which is not built for ThreadSanitizer: when a session thread logged first, the other threads'
+  // reads of the logger looked unordered to TSan (its fast path is an atomic it cannot see). It is
+  // no race — C++ makes the static's initialisation thread-safe — but creating it here, before any
+  // session thread starts, gives it an order TSan can see (thread creation) and keeps the report
+  // of a real race readable.
+  (void)spdlog::default_logger_raw();
   CaseSwitcher switcher(config.model.cases, config.model.load, config.render);
   // The first case is loaded here, before any thread starts (a bad case stops the session now).
   std::unique_ptr<PreparedCase> first = switcher.load_now(config.model.first_case);
@@ -168,7 +181,9 @@ SessionSummary run_session(const SessionConfig& config) {
   telemetry::TelemetryPublisher publisher(telemetry::PublisherConfig{config.lcm_url, 4096});
   telemetry::TelemetrySource& physics_out = publisher.add_source("physics");
   telemetry::TelemetrySource& devices_out = publisher.add_source("devices");
-  telemetry::CommandServer commands(publisher.lcm());
+  // Malformed packets on the command channel are counted in the publisher's receive statistics
+  // (VITREO_RECEIVE_STATUS) and never reach the server.
+  telemetry::CommandServer commands(publisher.lcm(), 64, &publisher.receive_stats().channel(telemetry::kChanCommand));
 
   std::string snapshot_dir = config.snapshot_dir;
   if (snapshot_dir.empty()) {
@@ -203,6 +218,8 @@ SessionSummary run_session(const SessionConfig& config) {
     ro.png_dir = config.png_dir;
     ro.png_every_frames = config.png_every_frames;
     ro.displays = config.displays;
+    ro.shm_ring_name = config.frame_ring_name;
+    ro.instructor_ring_name = config.instructor_ring_name;
     renderer = std::make_unique<render::RenderThread>(ro);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));
@@ -215,15 +232,20 @@ SessionSummary run_session(const SessionConfig& config) {
   harness_config.loop.period_ns = static_cast<std::int64_t>(config.model.dt_s * 1e9);
   harness_config.max_steps = config.steps;
   harness_config.physics_realtime = config.realtime;
-  const runtime::FixedStepLoop* loop = nullptr;  // the harness's loop; set before start()
+  runtime::FixedStepLoop* loop = nullptr;        // the harness's loop; set before start()
   std::unique_ptr<PreparedCase> retiring;        // a replaced case waiting for room in the ring
   // Case switches for the summary: fixed slots written by physics, read after it stopped.
   constexpr std::size_t kMaxSwitchLog = 64;
   std::array<std::pair<std::uint64_t, int>, kMaxSwitchLog> switch_log{};
   std::size_t switches = 0;
 
+  int stopped_by = 0;                              // the signal that ended the session early (physics thread)
   runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
+    // A stop request (SIGINT/SIGTERM) makes this step the session's last: it is finished, the end
+    // marker recorded, and nothing is cut off in the middle.
+    const int stop = config.stop ? config.stop->load(std::memory_order_relaxed) : 0;
+    const bool last = k + 1 == config.steps || stop != 0;
     if (config.on_step) config.on_step(k, hub);
     auto consume = [&](const telemetry::DeviceInput& in) {
       telemetry::DeviceInput stamped = in;
@@ -241,35 +263,35 @@ SessionSummary run_session(const SessionConfig& config) {
       if (!retiring) retiring = model.take_retired();
     }
     if (retiring && !switcher.retire(retiring)) { /* ring full: try again next step */ }
+    // Operator commands, decided here in order against the state the previous one left (its ack
+    // says so): a pending case switch counts as the current case, so "next, next" walks two cases.
     telemetry::AcceptedCommand cmd;
     while (commands.poll(cmd)) {
-      consume(command_input(cmd));
       const int target = switcher.pending() >= 0 ? switcher.pending() : model.case_index();
-      switch (cmd.code) {
-        case telemetry::CommandCode::NextCase: switcher.request(std::min(target + 1, model.case_count() - 1)); break;
-        case telemetry::CommandCode::PreviousCase: switcher.request(std::max(target - 1, 0)); break;
-        // Reset: the case the operator is in — or on the way to, when a switch is still loading.
-        case telemetry::CommandCode::Reset: switcher.request(target); break;
-        case telemetry::CommandCode::SaveSnapshot:
-          (void)snapshots.capture(model.world(), model.scene().description.name, cmd.arg, k);
-          break;
-        default: break;
+      const telemetry::CommandContext ctx{target, model.case_count(), model.paused()};
+      telemetry::CommandRefusal why = telemetry::decide_command(cmd.code, ctx);
+      if (why == telemetry::CommandRefusal::None && cmd.code == telemetry::CommandCode::SaveSnapshot &&
+          !snapshots.capture(model.world(), model.scene().description.name, cmd.arg, k))
+        why = telemetry::CommandRefusal::SnapshotBusy;
+      if (why == telemetry::CommandRefusal::None) {
+        consume(command_input(cmd));
+        switch (cmd.code) {
+          case telemetry::CommandCode::NextCase: switcher.request(target + 1); break;
+          case telemetry::CommandCode::PreviousCase: switcher.request(target - 1); break;
+          // Reset: the case the operator is in — or on the way to, when a switch is still loading.
+          case telemetry::CommandCode::Reset: switcher.request(target); break;
+          default: break;
+        }
       }
+      commands.report(cmd, why, ctx);
     }
-    // What the command server validates the next commands against: the case a pending switch
-    // leads to counts as current, so "next, next" walks two cases.
-    telemetry::CommandContext& context = commands.context().write_slot();
-    context.paused = model.paused();
-    context.case_index = switcher.pending() >= 0 ? switcher.pending() : model.case_index();
-    context.case_count = model.case_count();
-    commands.context().publish();
     hub.take_new(consume);
-    if (k + 1 == config.steps) consume(session_end_marker(config.steps));
+    if (last) consume(session_end_marker(k + 1));
     const core::StepReport report = model.step();
     // The model's metrics observed the step; running scores go out at a low rate (score() scans
     // the world), the final one with the last step.
-    if (k + 1 == config.steps || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
-      physics_out.push(score_item(model, step, k + 1 == config.steps));
+    if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
+      physics_out.push(score_item(model, step, last));
     for (const auto& slot : model.instruments()) {
       if (slot.frozen) {
         ++summary.frozen_steps;
@@ -282,7 +304,7 @@ SessionSummary run_session(const SessionConfig& config) {
     for (const auto& e : model.world().events()) {
       if (e.kind != core::TissueEventKind::kRolledBack) physics_out.push(to_event(e, step, t_s));
     }
-    for (const auto& e : model.instrument_system().events()) {
+    for (const auto& e : model.simulation().events()) {
       physics_out.push(instrument_event(e, step, t_s));
       ++summary.instrument_events;
       if (e.kind == core::InstrumentEventKind::kGrasp) ++summary.grasps;
@@ -294,7 +316,7 @@ SessionSummary run_session(const SessionConfig& config) {
         if (slots[i].present) physics_out.push(to_state(slots[i], static_cast<int>(i), step, t_s));
       }
     }
-    if (renderer && (k % view_every == 0 || k + 1 == config.steps)) {
+    if (renderer && (k % view_every == 0 || last)) {
       if (capture_view(model, k, t_s, views.write_slot())) views.publish();
     }
     if (loop && (k + 1) % 250 == 0) {  // physics timing at 4 Hz, cumulative over the session
@@ -302,12 +324,21 @@ SessionSummary run_session(const SessionConfig& config) {
       t.paused = model.paused();
       physics_out.push(t);
     }
+    if (last && stop != 0) {
+      stopped_by = stop;
+      loop->request_stop();
+    }
   });
   loop = &harness.loop();
+  std::int64_t next_receive_status_ns = 0;
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     publisher.pump();
     publisher.handle_incoming();
-    commands.pump_local();  // commands typed on the terminal: the same validation and queue
+    commands.pump_local();  // terminal commands in, physics' decisions back, acks out
+    if (const std::int64_t now = wall.now_ns(); now >= next_receive_status_ns) {  // 1 Hz (CHANNELS.md)
+      publisher.publish_receive_status("vitreo");
+      next_receive_status_ns = now + 1'000'000'000;
+    }
   });
   if (recorder) harness.add_service("recorder", std::chrono::milliseconds(20), [&] { recorder->pump(wall.now_ns()); });
   harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(!harness.physics_done()); });
@@ -334,8 +365,9 @@ SessionSummary run_session(const SessionConfig& config) {
   if (terminal) terminal->stop();
   harness.stop();
   hub.stop();
-  if (recorder) recorder->close();
+  commands.abandon_pending("the session ended before physics carried it out");
   publisher.pump();
+  publisher.publish_receive_status("vitreo");  // the session's last word on what it received
   if (renderer) {
     render_latest();  // the final state, so the last frame shows where the session ended
     renderer->stop();
@@ -357,6 +389,9 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.snapshots = snapshots.written();
 
   summary.steps = harness.loop().stats().steps;
+  if (stopped_by != 0) {
+    summary.stop_reason = stopped_by == SIGINT ? "SIGINT" : stopped_by == SIGTERM ? "SIGTERM" : "signal " + std::to_string(stopped_by);
+  }
   summary.simulated_s = static_cast<double>(summary.steps) * config.model.dt_s;
   summary.loop = harness.loop().stats();
   summary.inputs_applied = model.inputs_applied();
@@ -365,48 +400,87 @@ SessionSummary run_session(const SessionConfig& config) {
     summary.inputs_recorded = recorder->written();
     summary.recorder_dropped = recorder->dropped();
   }
+  for (const auto& row : publisher.receive_stats().snapshot()) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%-16s %llu received, %llu refused as malformed, %llu handler errors%s%s", row.channel.c_str(),
+                  static_cast<unsigned long long>(row.received), static_cast<unsigned long long>(row.rejected),
+                  static_cast<unsigned long long>(row.handler_errors), row.last_error.empty() ? "" : " (last: ",
+                  row.last_error.empty() ? "" : (row.last_error + ")").c_str());
+    summary.receive_lines.emplace_back(line);
+  }
   summary.telemetry_published = publisher.published();
   summary.telemetry_dropped = publisher.dropped();
   summary.state_hash = model.state_hash();
+  if (recorder) {
+    // The end event: the recording is complete, and says which state a replay must reach.
+    if (!recorder->finish(telemetry::RecordingEnd{static_cast<std::int64_t>(summary.steps), summary.state_hash, summary.stop_reason}))
+      summary.recording_problem = "the recording failed during the session (see the log): it is incomplete";
+    summary.inputs_recorded = recorder->written();
+    summary.recorder_dropped = recorder->dropped();
+  }
   summary.score_lines = score_lines(model);
   for (std::size_t i = 0; i < hub.device_count(); ++i) {
     const auto& st = hub.stats(i);
-    char line[256];
+    char line[512];
     std::snprintf(line, sizeof line, "%-10s frames %llu, valid %llu, CRC errors %llu, samples %llu, reconnects %llu",
                   hub.name(i).c_str(), static_cast<unsigned long long>(st.frames),
                   static_cast<unsigned long long>(st.valid), static_cast<unsigned long long>(st.crc_errors),
                   static_cast<unsigned long long>(st.samples_delivered), static_cast<unsigned long long>(st.reconnects));
     summary.device_lines.emplace_back(line);
+    // Sensor faults, each only when it happened: what a technician has to look at.
+    std::string faults;
+    auto add = [&](std::uint64_t n, const char* what) {
+      if (n == 0) return;
+      faults += (faults.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+    };
+    add(st.stuck_episodes, st.stuck_episodes == 1 ? "time stuck (instrument frozen)" : "times stuck (instrument frozen)");
+    add(st.stuck_samples, "samples while stuck");
+    add(st.range_rejected, "samples out of range");
+    add(st.timestamp_jumps, "timestamp jumps");
+    add(st.framing_errors, "framing errors");
+    add(st.drops, "frames missing (sequence gaps)");
+    add(st.version_errors + st.unknown_type + st.length_errors, "frames of another version, type or length");
+    if (!faults.empty()) summary.fault_lines.push_back(hub.name(i) + ": " + faults);
+  }
+  if (hub.reader_stalls() > 0) {
+    summary.fault_lines.push_back("driver thread starved " + std::to_string(hub.reader_stalls()) + " times (longest " +
+                                  std::to_string(hub.reader_stall_max_us() / 1000) +
+                                  " ms): framing errors and gaps may be this machine's load, not a device");
   }
   return summary;
 }
 
 ReplaySummary replay_session(const std::string& path, const ModelConfig& base, bool real_time) {
-  const telemetry::Recording rec = telemetry::read_recording(path);
+  const telemetry::Recording rec = telemetry::read_recording(path, &check_recorded_input);
   // The cases as they were recorded: their texts are in the header, not read from scenes/.
   ModelConfig model_config = base;
   if (rec.header.config_name != "vitreo-cases") {
-    throw std::runtime_error(path + ": recording has no case list (config '" + rec.header.config_name +
-                             "'); it was made by an older vitreo");
+    throw telemetry::RecordingError(path + ": recording has no case list (config '" + rec.header.config_name.substr(0, 64) +
+                                    "'); it was made by an older vitreo");
   }
   decode_case_list(rec.header.config_text, model_config);
   model_config.load.textures = false;  // physics only
   SimulationModel model(model_config);
   const std::string start = hex(model.current_case().start_hash);
-  if (!rec.header.snapshot_hash.empty() && rec.header.snapshot_hash != start) {
-    throw std::runtime_error(path + ": the recorded case '" + rec.header.case_id + "' rebuilds to start state " + start +
-                             ", the recording started from " + rec.header.snapshot_hash +
-                             " (a different build of the simulation?)");
+  if (rec.header.snapshot_hash != start) {
+    throw telemetry::RecordingError(path + ": the recorded case '" + rec.header.case_id.substr(0, 64) +
+                                    "' rebuilds to start state " + start + ", the recording started from " +
+                                    rec.header.snapshot_hash + " (a different build of the simulation?)");
+  }
+  for (const auto& in : rec.inputs) {
+    if (in.device_kind == kCaseKind && static_cast<int>(in.values[0]) >= model.case_count()) {
+      throw telemetry::RecordingError(path + ": an input at step " + std::to_string(in.step) + " switches to case " +
+                                      std::to_string(static_cast<int>(in.values[0])) + " of a list of " +
+                                      std::to_string(model.case_count()));
+    }
   }
   telemetry::InputCursor cursor(rec);
   std::uint64_t steps = 0;
   std::uint64_t inputs = 0;
-  // The session's last step is the last one that consumed an input, or later: replay as many steps
-  // as the header's duration says when present, else through the last input.
-  std::uint64_t total = rec.inputs.empty() ? 0 : static_cast<std::uint64_t>(rec.inputs.back().step) + 1;
-  for (const auto& in : rec.inputs) {
-    if (in.device_kind == kSessionEndKind && in.n_values >= 1) total = static_cast<std::uint64_t>(in.values[0]);
-  }
+  // A complete recording says how many steps the session ran; one that is not is replayed through
+  // the last step it can vouch for (read_recording decided which).
+  const std::int64_t through = rec.end ? rec.end->steps - 1 : rec.trusted_through_step;
+  const std::uint64_t total = through < 0 ? 0 : static_cast<std::uint64_t>(through) + 1;
   runtime::SimulatedClock sim;
   runtime::SteadyClock wall;
   runtime::Clock& clock = real_time ? static_cast<runtime::Clock&>(wall) : static_cast<runtime::Clock&>(sim);
@@ -430,6 +504,12 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.case_id = rec.header.case_id;
   for (const auto& c : model_config.cases) out.cases.push_back(c.file_name);
+  out.verdict = rec.verdict;
+  out.verdict_text = rec.describe();
+  if (rec.end) {
+    out.recorded_state_hash = rec.end->state_hash;
+    out.stop_reason = rec.end->stop_reason;
+  }
   return out;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // A whole session: devices → physics (fixed step) → telemetry and recording, on separate threads
 // (rig/runtime/README.md has the diagram). Physics only ever touches wait-free mailboxes.
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
@@ -11,6 +12,7 @@
 #include "rig/runtime/fixed_step_loop.hpp"
 #include "rig/session/device_hub.hpp"
 #include "rig/session/simulation_model.hpp"
+#include "rig/telemetry/recording.hpp"
 #include "vitreo/render/kms_display.hpp"
 
 namespace vitreo::rig {
@@ -19,6 +21,10 @@ struct SessionConfig {
   ModelConfig model;  // the case list (the first case is model.cases[model.first_case])
   std::vector<DeviceSpec> devices;
   std::uint64_t steps = 5000;
+  // Set (to the signal's number) by whoever wants the session to end early — vitreo's SIGINT/SIGTERM
+  // handler: physics finishes the step it is in, records the end and stops; the recording is
+  // complete and the summary says why it ended. nullptr: run all `steps`.
+  const std::atomic<int>* stop = nullptr;
   std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
   std::string record_path;  // empty: no recording
   // Operator "save snapshot NAME" writes NAME.snapshot here (core/scene/snapshot format); empty:
@@ -43,6 +49,9 @@ struct SessionConfig {
   double display_hz = 30.0;
   std::string png_dir;
   std::uint64_t png_every_frames = 0;
+  // Shared-memory rings (rig/render/frame_ring.hpp) for a viewer or recorder: the stereo frames, and
+  // the instructor's view (the left eye with score, retina force and events over it); empty: none.
+  std::string frame_ring_name, instructor_ring_name;
   // The rig's displays (KMS scan-out, rig/render/kms_display.hpp); empty: headless.
   std::vector<vitreo::render::KmsOptions> displays;
   // Running scores on VITREO_SCORE every this many steps (and a final one at the end).
@@ -61,9 +70,15 @@ struct SessionSummary {
   runtime::LoopStats loop;
   std::uint64_t inputs_applied = 0, inputs_refused = 0, inputs_recorded = 0, recorder_dropped = 0;
   std::uint64_t tears = 0, attachments_broken = 0, rolled_back = 0;
+  std::string stop_reason = "duration reached";  // or "SIGTERM", "SIGINT" (SessionConfig::stop)
+  std::string recording_problem;                 // empty when the recording is complete
   std::uint64_t telemetry_published = 0, telemetry_dropped = 0;
+  std::vector<std::string> receive_lines;  // per subscribed LCM channel: received, refused, handler errors
   std::uint64_t state_hash = 0;
   std::vector<std::string> device_lines;  // per device: name, link statistics
+  // Sensor faults (stuck, out of range, timestamp jumps, framing errors, gaps) per device that had
+  // any, and the driver thread's starvation; empty when all was well.
+  std::vector<std::string> fault_lines;
   std::uint64_t instrument_events = 0;     // grasps, contacts, collisions, burns… (telemetry VITREO_EVENT)
   std::uint64_t frozen_steps = 0;          // steps during which an instrument was frozen (its tracker lost)
   std::uint64_t frames_rendered = 0, scenes_dropped = 0;
@@ -86,6 +101,13 @@ struct SessionSummary {
 SessionSummary run_session(const SessionConfig& config);
 
 struct ReplaySummary {
+  // What the recording turned out to be (telemetry::read_recording) and, for a complete one, the
+  // final state it recorded: a replay that is not complete, or reaches another state, is no proof.
+  telemetry::RecordingVerdict verdict = telemetry::RecordingVerdict::Complete;
+  std::string verdict_text;                  // "complete (...)", "truncated at step N — replayed up to there"
+  std::optional<std::uint64_t> recorded_state_hash;
+  std::string stop_reason;                   // how the recorded session ended
+  bool matches_recording() const { return recorded_state_hash && *recorded_state_hash == state_hash; }
   std::uint64_t steps = 0;
   std::uint64_t inputs = 0;
   std::uint64_t state_hash = 0;
@@ -98,7 +120,10 @@ struct ReplaySummary {
 // Replays a recording through the same model as fast as possible (simulated clock), or at real
 // time when `real_time` is set. The cases (their file and library texts, resolution overrides) come
 // from the recording, not from scenes/; `model` supplies the rest (pedal mapping, calibration, the
-// cache folder). Throws std::runtime_error when the rebuilt start differs from the recorded one.
+// cache folder). Only what the recording can vouch for is replayed: a truncated or corrupted one
+// up to its last verified step (the verdict says so). Throws telemetry::RecordingError when it
+// cannot be replayed at all (no header, another format, a case list that does not decode, a start
+// state the case no longer rebuilds to).
 ReplaySummary replay_session(const std::string& recording_path, const ModelConfig& model, bool real_time = false);
 
 }  // namespace vitreo::rig

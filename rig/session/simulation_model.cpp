@@ -9,65 +9,6 @@
 
 namespace vitreo::rig {
 
-// ---- The case list as text ----------------------------------------------------------------------
-// "vitreo-cases 1\n" then "key value\n" lines, then per case "case <name bytes> <text bytes>
-// <library bytes>\n" followed by exactly those bytes. Lengths, not delimiters: the texts are free.
-
-std::string encode_case_list(const ModelConfig& c) {
-  std::string out = "vitreo-cases 1\n";
-  out += "first_case " + std::to_string(c.first_case) + "\n";
-  out += "retina_vertices " + std::to_string(c.load.retina_vertices) + "\n";
-  out += "texture_size_px " + std::to_string(c.load.texture_size_px) + "\n";
-  for (const auto& t : c.cases) {
-    out += "case " + std::to_string(t.file_name.size()) + " " + std::to_string(t.text.size()) + " " +
-           std::to_string(t.library_text.size()) + "\n";
-    out += t.file_name;
-    out += t.text;
-    out += t.library_text;
-  }
-  return out;
-}
-
-void decode_case_list(const std::string& text, ModelConfig& config) {
-  auto fail = [](const std::string& why) { throw std::runtime_error("recording's case list: " + why); };
-  std::size_t at = 0;
-  auto line = [&]() {
-    const std::size_t nl = text.find('\n', at);
-    if (nl == std::string::npos) fail("truncated");
-    std::string l = text.substr(at, nl - at);
-    at = nl + 1;
-    return l;
-  };
-  if (line() != "vitreo-cases 1") fail("not a vitreo case list (or a newer version)");
-  ModelConfig out = config;
-  out.cases.clear();
-  while (at < text.size()) {
-    const std::string l = line();
-    long long a = 0, b = 0, c = 0;
-    char key[32] = {};
-    if (std::sscanf(l.c_str(), "case %lld %lld %lld", &a, &b, &c) == 3) {
-      if (a < 0 || b < 0 || c < 0 || static_cast<std::size_t>(a + b + c) > text.size() - at) fail("case text truncated");
-      scene_io::CaseText t;
-      t.file_name = text.substr(at, static_cast<std::size_t>(a));
-      t.text = text.substr(at + static_cast<std::size_t>(a), static_cast<std::size_t>(b));
-      t.library_text = text.substr(at + static_cast<std::size_t>(a + b), static_cast<std::size_t>(c));
-      at += static_cast<std::size_t>(a + b + c);
-      out.cases.push_back(std::move(t));
-    } else if (std::sscanf(l.c_str(), "%31s %lld", key, &a) == 2) {
-      const std::string k = key;
-      if (k == "first_case") out.first_case = static_cast<int>(a);
-      else if (k == "retina_vertices") out.load.retina_vertices = static_cast<int>(a);
-      else if (k == "texture_size_px") out.load.texture_size_px = static_cast<int>(a);
-      else fail("unknown key '" + k + "'");
-    } else {
-      fail("bad line '" + l + "'");
-    }
-  }
-  if (out.cases.empty()) fail("no cases");
-  if (out.first_case < 0 || out.first_case >= static_cast<int>(out.cases.size())) fail("first case out of range");
-  config = std::move(out);
-}
-
 // ---- The model ------------------------------------------------------------------------------------
 
 SimulationModel::SimulationModel(const ModelConfig& config)
@@ -93,6 +34,9 @@ void SimulationModel::install(std::unique_ptr<PreparedCase> c) {
   eye_rotation_ = core::Quat::Identity();
   eye_tracked_ = false;
   paused_ = false;
+  // The microscope starts centred on the case's region of interest.
+  microscope_ = core::Microscope(config_.microscope, case_->scene->eye.fundus_coords(case_->focus_mm),
+                                 case_->scene->description.view.wide_angle);
   ++case_loads_;
 }
 
@@ -131,14 +75,23 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       case 5: ++resets_; break;        // Reset: requested here, the reload arrives as kCaseKind
       case 7: wireframe_ = !wireframe_; break;
       case 8: labels_ = !labels_; break;
-      case 9: zoom_override_ = in.values[1]; break;
+      case 9: microscope_.set_zoom(in.values[1]); break;
+      case 10: microscope_.pan_to(core::Vec2(in.values[1], in.n_values >= 3 ? in.values[2] : 0.0)); break;
+      case 11: microscope_.set_focus(in.values[1]); break;
+      case 12: flat_shading_ = !flat_shading_; break;
+      case 13: microscope_.toggle_wide_angle(); break;
+      case 14: microscope_.toggle_reinverter(); break;
       default: break;
     }
     ok = true;
   } else if (in.device_kind == kLinkKind && in.n_values >= 1) {
-    // Which instrument a tracker link carries is its channel.
-    if (in.channel >= 0 && in.channel < static_cast<int>(instruments_.size())) {
-      instruments_[static_cast<std::size_t>(in.channel)].frozen = static_cast<int>(in.values[0]) == static_cast<int>(LinkInput::Lost);
+    // Which instrument a tracker link carries is its channel; the pedals' and the fixture's links
+    // freeze no instrument (values[1]: the device's type, 1 a tracker; absent in older recordings).
+    const bool tracker = in.n_values < 2 || in.values[1] == 1.0;
+    if (tracker && in.channel >= 0 && in.channel < static_cast<int>(instruments_.size())) {
+      const int state = static_cast<int>(in.values[0]);
+      instruments_[static_cast<std::size_t>(in.channel)].frozen =
+          state == static_cast<int>(LinkInput::Lost) || state == static_cast<int>(LinkInput::Stuck);
     }
     ok = true;
   } else if (DecodedTracker t; decode_tracker(in, t)) {
@@ -159,7 +112,12 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       }
     }
   } else if (PedalReading p; decode_pedals(in, p)) {
+    const SurgicalControls before = pedals_.controls();
     ok = pedals_.apply(p);
+    // The pedal's zoom and focus are targets for the microscope's motors when they move (a command
+    // holds until the pedal moves again).
+    if (ok && pedals_.controls().zoom != before.zoom) microscope_.set_zoom(pedals_.controls().zoom);
+    if (ok && pedals_.controls().focus_offset_mm != before.focus_offset_mm) microscope_.set_focus(pedals_.controls().focus_offset_mm);
   } else if (DecodedEyeball e; decode_eyeball(in, e)) {
     const double n = e.orientation.coeffs().norm();
     if (std::abs(n - 1.0) < 1e-3) {
@@ -175,7 +133,7 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
 core::StepReport SimulationModel::step() {
   if (paused_) return {};
   const SurgicalControls& c = pedals_.controls();
-  core::InstrumentSystem& sys = *case_->system;
+  core::Simulation& sys = *case_->sim;
   const int tool = selected_tool();
   const double vacuum = pedals_.mapping().vacuum_max_mmhg > 0.0 ? c.vacuum_mmhg / pedals_.mapping().vacuum_max_mmhg : 0.0;
   auto tracked = [&](const InstrumentSlot& slot) {
@@ -210,12 +168,11 @@ core::StepReport SimulationModel::step() {
     (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
   sys.set_air_infusion(c.air_infusion);
+  microscope_.step(config_.dt_s, core::MicroscopeInput{core::Vec2(c.pan_x, c.pan_y)});
   sys.set_eye_fixture_rotation(eye_tracked_ ? std::optional<core::Quat>(eye_rotation_) : std::nullopt);
   ++steps_;
-  const core::StepReport report = sys.step(config_.dt_s).tissue;
-  // Metrics observe every step here, in the model, so a replay measures the same session exactly.
-  (void)case_->metrics->observe(config_.dt_s);
-  return report;
+  // The case's metrics observe the step as its last stage, so a replay measures the same session.
+  return sys.step(config_.dt_s).tissue;
 }
 
 std::uint64_t SimulationModel::state_hash() const {
@@ -226,8 +183,8 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_u64(steps_);
   h.add_u64(applied_);
   h.add_u64(resets_);
-  h.add_u64((paused_ ? 1u : 0u) | (wireframe_ ? 2u : 0u) | (labels_ ? 4u : 0u));
-  h.add_double(zoom_override_);
+  h.add_u64((paused_ ? 1u : 0u) | (wireframe_ ? 2u : 0u) | (labels_ ? 4u : 0u) | (flat_shading_ ? 8u : 0u));
+  microscope_.hash_into(h);
   h.add_u64(refused_);
   for (const auto& slot : instruments_) {
     h.add_u64((slot.present ? 1u : 0u) | (slot.frozen ? 2u : 0u) | (slot.pose.inserted ? 4u : 0u));
@@ -240,6 +197,9 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.vacuum_mmhg);
   h.add_double(c.cut_rate_cpm);
   h.add_double(c.zoom);
+  h.add_double(c.focus_offset_mm);
+  h.add_double(c.pan_x);
+  h.add_double(c.pan_y);
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
   h.add_u64(c.air_infusion ? 1u : 0u);

@@ -12,7 +12,8 @@
 
 #include <string>
 
-#include "core/instruments/instrument_system.hpp"
+#include "core/sim/simulation.hpp"
+#include "core/scene/microscope.hpp"
 #include "rig/input/controls.hpp"
 #include "rig/input/port_pivot.hpp"
 #include "rig/scene_io/case_loader.hpp"
@@ -23,8 +24,9 @@ namespace vitreo::rig {
 
 // A link's state as an input: a lost tracker must freeze its instrument in replay exactly when it
 // did live, so link changes are recorded like samples (device_kind kLinkKind, values[0] = state).
+// A stuck sensor (bit-identical poses for 50 ms) freezes its instrument the same way; Up ends both.
 inline constexpr std::int8_t kLinkKind = 4;
-enum class LinkInput : int { Up = 1, Lost = 2 };
+enum class LinkInput : int { Up = 1, Lost = 2, Stuck = 3 };
 // The session's end, recorded at its last step (values[0] = steps run) so a replay knows its length.
 inline constexpr std::int8_t kSessionEndKind = 5;
 // An accepted operator command (values[0] = telemetry::CommandCode, values[1] = its value): pause,
@@ -34,6 +36,11 @@ inline constexpr std::int8_t kCommandKind = 6;
 // take effect when the loader thread has the case ready, so the step they land on is recorded.
 inline constexpr std::int8_t kCaseKind = 7;
 
+// A recorded input's meaning, range-checked (telemetry::read_recording's InputCheck): a known kind,
+// finite values, a session-end marker that counts its own step, a case index and a command code that
+// exist. nullptr when fine, else why not.
+const char* check_recorded_input(const telemetry::DeviceInput& in) noexcept;
+
 struct ModelConfig {
   // The session's cases (scenes/*.toml as text, so a recording can carry them); first_case starts.
   std::vector<scene_io::CaseText> cases;
@@ -42,6 +49,7 @@ struct ModelConfig {
   double dt_s = 1e-3;
   PedalMapping pedals;
   TrackerCalibration calibration;
+  core::MicroscopeSettings microscope;
 };
 
 // The case list and overrides as one text (stored in a recording's header), and back. decode throws
@@ -74,17 +82,20 @@ class SimulationModel {
   void stage(std::unique_ptr<PreparedCase> prepared) { staged_ = std::move(prepared); }
   bool has_staged() const { return staged_ != nullptr; }
   std::unique_ptr<PreparedCase> take_retired() { return std::move(retired_); }
-  // One physics step (skipped while paused). Returns the core's report.
+  // Maps the inputs onto the case's instruments and runs one core::Simulation step, metrics
+  // included (skipped while paused). Returns the tissue's report.
   core::StepReport step();
   bool paused() const { return paused_; }
-  // View state the operator sets (wireframe and labels toggles, microscope zoom override).
+  // View state the operator sets: wireframe, labels (the case's guides and the structures' names,
+  // shown at the start) and flat shading toggles; the microscope (pedal and commands drive it).
   bool wireframe() const { return wireframe_; }
   bool labels() const { return labels_; }
-  double zoom_override() const { return zoom_override_; }
+  bool flat_shading() const { return flat_shading_; }
+  const core::Microscope& microscope() const { return microscope_; }
   std::uint64_t resets() const { return resets_; }
 
   core::TissueWorld& world() { return case_->scene->world; }
-  const core::InstrumentSystem& instrument_system() const { return *case_->system; }
+  const core::Simulation& simulation() const { return *case_->sim; }
   const core::TissueWorld& world() const { return case_->scene->world; }
   const core::Scene& scene() const { return *case_->scene; }
   const PreparedCase& current_case() const { return *case_; }
@@ -118,8 +129,8 @@ class SimulationModel {
   std::array<InstrumentSlot, 4> instruments_{};
   core::Quat eye_rotation_ = core::Quat::Identity();
   bool paused_ = false;
-  bool wireframe_ = false, labels_ = false;
-  double zoom_override_ = 0.0;  // 0: the pedal's zoom
+  bool wireframe_ = false, labels_ = true, flat_shading_ = false;
+  core::Microscope microscope_{core::MicroscopeSettings{}, core::Vec2::Zero()};
   std::uint64_t applied_ = 0, refused_ = 0, steps_ = 0, resets_ = 0;
 };
 

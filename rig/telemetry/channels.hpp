@@ -14,5 +14,8 @@ inline constexpr const char* kChanCommand = "VITREO_COMMAND";
 inline constexpr const char* kChanCommandAck = "VITREO_COMMAND_ACK";
 inline constexpr const char* kChanRecHeader = "VITREO_REC_HEADER";
 inline constexpr const char* kChanRecInput = "VITREO_REC_INPUT";
+inline constexpr const char* kChanRecCheck = "VITREO_REC_CHECK";
+inline constexpr const char* kChanRecEnd = "VITREO_REC_END";
+inline constexpr const char* kChanReceiveStatus = "VITREO_RECEIVE_STATUS";
 
 }  // namespace vitreo::telemetry

@@ -72,6 +72,9 @@ struct DeviceStatus {
   std::int64_t frames_rx = 0, frames_tx = 0, bytes_rx = 0, crc_errors = 0, framing_errors = 0;
   std::int64_t sequence_gaps = 0, heartbeat_misses = 0, reconnects = 0, last_sample_age_us = 0;
   float sample_rate_hz = 0, latency_p50_us = 0, latency_p99_us = 0, clock_offset_us = 0;
+  bool stuck = false;
+  std::int64_t stuck_episodes = 0, stuck_samples = 0, range_rejected = 0, timestamp_jumps = 0, reader_stalls = 0;
+  float reader_stall_max_ms = 0;
 };
 
 struct Score {

@@ -1,5 +1,6 @@
 #include "rig/telemetry/publisher.hpp"
 
+#include <algorithm>
 #include <ctime>
 #include <stdexcept>
 #include <type_traits>
@@ -8,6 +9,7 @@
 #include "vitreo_lcm/event_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 #include "vitreo_lcm/physics_timing_t.hpp"
+#include "vitreo_lcm/receive_status_t.hpp"
 #include "vitreo_lcm/score_t.hpp"
 
 namespace vitreo::telemetry {
@@ -52,6 +54,27 @@ int TelemetryPublisher::handle_incoming(int max_messages) {
   int n = 0;
   while (n < max_messages && lcm_.handleTimeout(0) > 0) ++n;
   return n;
+}
+
+void TelemetryPublisher::publish_receive_status(const std::string& process) {
+  const std::vector<ReceiveStats::Row> rows = receive_stats_.snapshot();
+  if (rows.empty()) return;
+  vitreo_lcm::receive_status_t m;
+  m.utime_us = wall_time_us();
+  m.process = process;
+  m.n = static_cast<std::int16_t>(std::min<std::size_t>(rows.size(), 256));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(m.n); ++i) {
+    m.channel.push_back(rows[i].channel);
+    m.received.push_back(static_cast<std::int64_t>(rows[i].received));
+    m.rejected.push_back(static_cast<std::int64_t>(rows[i].rejected));
+    m.handler_errors.push_back(static_cast<std::int64_t>(rows[i].handler_errors));
+    m.last_error.push_back(rows[i].last_error);
+  }
+  if (lcm_.publish(kChanReceiveStatus, &m) == 0) {
+    ++published_;
+  } else {
+    ++publish_errors_;
+  }
 }
 
 std::size_t TelemetryPublisher::pump() {
@@ -147,6 +170,13 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.latency_p50_us = v.latency_p50_us;
           m.latency_p99_us = v.latency_p99_us;
           m.clock_offset_us = v.clock_offset_us;
+          m.stuck = v.stuck;
+          m.stuck_episodes = v.stuck_episodes;
+          m.stuck_samples = v.stuck_samples;
+          m.range_rejected = v.range_rejected;
+          m.timestamp_jumps = v.timestamp_jumps;
+          m.reader_stalls = v.reader_stalls;
+          m.reader_stall_max_ms = v.reader_stall_max_ms;
           rc = publish(lcm_, kChanDeviceStatus, m);
         } else if constexpr (std::is_same_v<T, Score>) {
           vitreo_lcm::score_t m;

@@ -22,6 +22,7 @@
 #include "rig/runtime/spsc_ring.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/items.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
 
 namespace vitreo::telemetry {
 
@@ -59,6 +60,11 @@ class TelemetryPublisher {
   int handle_incoming(int max_messages = 64);
 
   lcm::LCM& lcm() noexcept { return lcm_; }
+  // What arrives on the channels this process subscribes to (subscriptions count into it).
+  ReceiveStats& receive_stats() noexcept { return receive_stats_; }
+  // Telemetry thread: one receive_status_t (VITREO_RECEIVE_STATUS) listing every channel counted in
+  // receive_stats(); nothing when none is. CHANNELS.md: 1 Hz and once at the end.
+  void publish_receive_status(const std::string& process);
   std::uint64_t published() const noexcept { return published_; }
   std::uint64_t publish_errors() const noexcept { return publish_errors_; }
   std::uint64_t dropped() const noexcept;  // sum over sources (any thread)
@@ -68,6 +74,7 @@ class TelemetryPublisher {
 
   PublisherConfig config_;
   lcm::LCM lcm_;
+  ReceiveStats receive_stats_;
   std::deque<TelemetrySource> sources_;
   std::uint64_t published_ = 0;
   std::uint64_t publish_errors_ = 0;

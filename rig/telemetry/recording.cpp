@@ -1,31 +1,15 @@
+// What the recorder and the reader share: the input codec with its range checks, bitwise input
+// equality, verdict texts, and paced replay of a read recording.
 #include "rig/telemetry/recording.hpp"
-
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
-#include <stdexcept>
 
-#include <lcm/lcm-cpp.hpp>
-#include <spdlog/spdlog.h>
-
-#include "rig/telemetry/channels.hpp"
-#include "rig/telemetry/publisher.hpp"
-#include "vitreo_lcm/device_input_t.hpp"
-#include "vitreo_lcm/recording_header_t.hpp"
+#include "rig/telemetry/input_codec.hpp"
 
 namespace vitreo::telemetry {
-namespace {
-
-std::int64_t monotonic_us() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000 + ts.tv_nsec / 1000;
-}
 
 vitreo_lcm::device_input_t to_lcm(const DeviceInput& in) {
   vitreo_lcm::device_input_t m;
@@ -45,9 +29,13 @@ vitreo_lcm::device_input_t to_lcm(const DeviceInput& in) {
   return m;
 }
 
-bool from_lcm(const vitreo_lcm::device_input_t& m, DeviceInput& in) {
-  if (m.n_values < 0 || static_cast<std::size_t>(m.n_values) > DeviceInput::kMaxValues) return false;
-  if (m.n_raw < 0 || static_cast<std::size_t>(m.n_raw) > DeviceInput::kMaxRaw) return false;
+const char* from_lcm(const vitreo_lcm::device_input_t& m, DeviceInput& in) noexcept {
+  if (m.n_values < 0 || static_cast<std::size_t>(m.n_values) > DeviceInput::kMaxValues) return "more than 16 values";
+  if (m.n_raw < 0 || static_cast<std::size_t>(m.n_raw) > DeviceInput::kMaxRaw) return "more than 64 raw bytes";
+  if (m.values.size() != static_cast<std::size_t>(m.n_values) || m.raw.size() != static_cast<std::size_t>(m.n_raw))
+    return "counts and arrays disagree";
+  if (m.step < 0 || m.step > kMaxRecordedStep) return "step out of range";
+  if (m.device_kind <= 0) return "device kind out of range";
   in = DeviceInput{};
   in.host_time_us = m.host_time_us;
   in.device_time_us = m.device_time_us;
@@ -60,16 +48,8 @@ bool from_lcm(const vitreo_lcm::device_input_t& m, DeviceInput& in) {
   std::copy(m.values.begin(), m.values.end(), in.values);
   in.n_raw = static_cast<std::uint8_t>(m.n_raw);
   std::copy(m.raw.begin(), m.raw.end(), in.raw);
-  return true;
+  return nullptr;
 }
-
-template <class Msg>
-void encode(const Msg& m, std::vector<std::uint8_t>& buf) {
-  buf.resize(static_cast<std::size_t>(m.getEncodedSize()));
-  if (m.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0) throw std::runtime_error("LCM encode failed");
-}
-
-}  // namespace
 
 bool operator==(const DeviceInput& a, const DeviceInput& b) noexcept {
   if (a.host_time_us != b.host_time_us || a.device_time_us != b.device_time_us || a.step != b.step ||
@@ -81,136 +61,37 @@ bool operator==(const DeviceInput& a, const DeviceInput& b) noexcept {
          std::memcmp(a.raw, b.raw, std::min<std::size_t>(a.n_raw, DeviceInput::kMaxRaw)) == 0;
 }
 
-Recorder::Recorder(const std::string& path, RecordingHeader header, RecorderConfig config)
-    : path_(path), config_(config), ring_(config.ring_capacity) {
-  log_ = std::make_unique<lcm::LogFile>(path, "w");
-  if (!log_->good()) throw std::runtime_error("recorder: cannot create '" + path + "': " + std::strerror(errno));
-  wall_minus_mono_us_ = wall_time_us() - monotonic_us();
-  header.utime_us = wall_time_us();
-  vitreo_lcm::recording_header_t h;
-  h.utime_us = header.utime_us;
-  h.format_version = vitreo_lcm::recording_header_t::FORMAT_VERSION;
-  h.software_version = header.software_version;
-  h.case_id = header.case_id;
-  h.step_period_us = header.step_period_us;
-  h.config_name = header.config_name;
-  h.config_text = header.config_text;
-  h.snapshot_ref = header.snapshot_ref;
-  h.snapshot_hash = header.snapshot_hash;
-  encode(h, buf_);
-  lcm::LogEvent ev{};
-  ev.eventnum = event_num_++;
-  ev.timestamp = header.utime_us;
-  ev.channel = kChanRecHeader;
-  ev.datalen = static_cast<std::int32_t>(buf_.size());
-  ev.data = buf_.data();
-  if (log_->writeEvent(&ev) != 0) throw std::runtime_error("recorder: cannot write header to '" + path + "'");
-  flush();  // the header is on disk before the first input is
-  buf_.reserve(1024);
-}
-
-Recorder::~Recorder() { close(); }
-
-void Recorder::write_input(const DeviceInput& in) {
-  encode(to_lcm(in), buf_);
-  lcm::LogEvent ev{};
-  ev.eventnum = event_num_++;
-  ev.timestamp = in.host_time_us + wall_minus_mono_us_;
-  ev.channel = kChanRecInput;
-  ev.datalen = static_cast<std::int32_t>(buf_.size());
-  ev.data = buf_.data();
-  if (log_->writeEvent(&ev) != 0) throw std::runtime_error("recorder: write failed on '" + path_ + "'");
-  ++written_;
-}
-
-void Recorder::flush() {
-  if (std::fflush(log_->getFilePtr()) != 0) throw std::runtime_error("recorder: flush failed on '" + path_ + "'");
-  ++flushes_;
-}
-
-void Recorder::fail(const char* what) noexcept {
-  if (!failed_) spdlog::error("{} — recording stopped, the session goes on", what);
-  failed_ = true;
-  log_.reset();  // closes the file: what was written so far stays readable
-}
-
-void Recorder::discard_queued() noexcept {
-  DeviceInput in;
-  while (ring_.try_pop(in)) ++lost_;
-}
-
-std::size_t Recorder::pump(std::int64_t now_ns) noexcept {
-  if (!log_) {
-    discard_queued();
-    return 0;
+const char* to_string(RecordingVerdict v) noexcept {
+  switch (v) {
+    case RecordingVerdict::Complete: return "complete";
+    case RecordingVerdict::Truncated: return "truncated";
+    case RecordingVerdict::Corrupted: return "corrupted";
   }
-  std::size_t n = 0;
-  try {
-    DeviceInput in;
-    while (ring_.try_pop(in)) {
-      write_input(in);
-      ++n;
-    }
-    if (last_flush_ns_ == INT64_MIN || now_ns - last_flush_ns_ >= config_.flush_interval_ns) {
-      flush();
-      last_flush_ns_ = now_ns;
-    }
-  } catch (const std::exception& e) {
-    ++lost_;  // the input being written
-    fail(e.what());
-    discard_queued();
-  }
-  return n;
+  return "?";
 }
 
-void Recorder::close() noexcept {
-  if (!log_) return;
-  try {
-    DeviceInput in;
-    while (ring_.try_pop(in)) write_input(in);
-    flush();
-    fdatasync(fileno(log_->getFilePtr()));
-    log_.reset();
-  } catch (const std::exception& e) {
-    fail(e.what());
-    discard_queued();
+std::string Recording::describe() const {
+  char buf[512];
+  switch (verdict) {
+    case RecordingVerdict::Complete:
+      std::snprintf(buf, sizeof buf, "complete (%lld steps, %zu inputs, every checksum verified)",
+                    static_cast<long long>(end ? end->steps : 0), inputs.size());
+      break;
+    case RecordingVerdict::Truncated:
+      if (trusted_through_step < 0) {
+        std::snprintf(buf, sizeof buf, "truncated before its first verified step — nothing to replay (%s)", problem.c_str());
+      } else {
+        std::snprintf(buf, sizeof buf, "truncated at step %lld — replayed up to there (%s)",
+                      static_cast<long long>(trusted_through_step), problem.c_str());
+      }
+      break;
+    case RecordingVerdict::Corrupted:
+      std::snprintf(buf, sizeof buf, "corrupted at byte %llu — replayed up to there, through step %lld (%s)",
+                    static_cast<unsigned long long>(bad_byte), static_cast<long long>(trusted_through_step),
+                    problem.c_str());
+      break;
   }
-}
-
-Recording read_recording(const std::string& path) {
-  lcm::LogFile log(path, "r");
-  if (!log.good()) throw std::runtime_error("recording: cannot open '" + path + "'");
-  Recording rec;
-  bool have_header = false;
-  long good_end = 0;
-  const lcm::LogEvent* ev = nullptr;
-  while ((ev = log.readNextEvent()) != nullptr) {
-    if (!have_header) {
-      vitreo_lcm::recording_header_t h;
-      if (ev->channel != kChanRecHeader || h.decode(ev->data, 0, ev->datalen) < 0)
-        throw std::runtime_error("recording: '" + path + "' does not start with a " + kChanRecHeader + " event");
-      if (h.format_version < 1 || h.format_version > vitreo_lcm::recording_header_t::FORMAT_VERSION)
-        throw std::runtime_error("recording: '" + path + "' has format version " + std::to_string(h.format_version) +
-                                 ", this build reads 1.." +
-                                 std::to_string(vitreo_lcm::recording_header_t::FORMAT_VERSION));
-      rec.header = RecordingHeader{h.utime_us,     h.format_version, h.software_version, h.case_id, h.step_period_us,
-                                   h.config_name,  h.config_text,    h.snapshot_ref,     h.snapshot_hash};
-      have_header = true;
-    } else if (ev->channel == kChanRecInput) {
-      vitreo_lcm::device_input_t m;
-      DeviceInput in;
-      if (m.decode(ev->data, 0, ev->datalen) < 0 || !from_lcm(m, in))
-        throw std::runtime_error("recording: undecodable input event " + std::to_string(ev->eventnum) + " in '" + path + "'");
-      rec.inputs.push_back(in);
-    } else {
-      ++rec.other_events;
-    }
-    good_end = std::ftell(log.getFilePtr());
-  }
-  if (!have_header) throw std::runtime_error("recording: '" + path + "' is empty or has no header");
-  struct stat st{};
-  if (::stat(path.c_str(), &st) == 0) rec.truncated = st.st_size != good_end;
-  return rec;
+  return buf;
 }
 
 std::size_t replay(const Recording& rec, runtime::Clock& clock, ReplayOptions options,

@@ -31,14 +31,23 @@ void TerminalCommands::stop() {
 
 void TerminalCommands::run() {
   std::string pending;
+  bool overlong = false;  // inside a line longer than kMaxLine: dropped up to its newline
   char buf[512];
+  auto take_line = [&](std::string line) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty()) handle_line(line);
+  };
   while (running_.load()) {
     pollfd p{fd_, POLLIN, 0};
     const int r = ::poll(&p, 1, 100);  // wakes up to notice stop()
     if (r < 0 && errno != EINTR) return;
     if (r <= 0) continue;
     const ssize_t n = ::read(fd_, buf, sizeof buf);
-    if (n == 0) return;  // end of input: no more commands
+    if (n == 0) {
+      // End of input: a last line without its newline is still a command.
+      if (!overlong) take_line(std::move(pending));
+      return;
+    }
     if (n < 0) {
       if (errno == EINTR || errno == EAGAIN) continue;
       return;
@@ -47,9 +56,19 @@ void TerminalCommands::run() {
     for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos;) {
       std::string line = pending.substr(0, nl);
       pending.erase(0, nl + 1);
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      if (line.empty()) continue;
-      handle_line(line);
+      if (overlong) {
+        overlong = false;
+        continue;
+      }
+      take_line(std::move(line));
+    }
+    if (pending.size() > kMaxLine) {  // no newline in sight: refuse it rather than grow without bound
+      ++lines_;
+      ++refused_;
+      std::fprintf(out_, "> line longer than %zu characters: ignored\n", kMaxLine);
+      std::fflush(out_);
+      pending.clear();
+      overlong = true;
     }
   }
 }

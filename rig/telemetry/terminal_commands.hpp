@@ -6,7 +6,8 @@
 // from LCM, queues accepted ones to physics and publishes the ack — and prints the ack:
 //   > next: accepted
 //   > zoom: refused: zoom 99 outside the rig's range 1..25
-// Syntax errors are printed at once and never reach the server.
+// Syntax errors are printed at once and never reach the server. Each line waits for its ack before
+// the next is sent, so acks come back in order; the last line counts even without its newline.
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
@@ -18,6 +19,7 @@ namespace vitreo::telemetry {
 
 class TerminalCommands {
  public:
+  static constexpr std::size_t kMaxLine = 1024;  // longer lines are refused, not buffered
   // Does not take ownership of `fd`. `out`: where acks are printed.
   TerminalCommands(int fd, CommandServer& server, std::FILE* out = stdout);
   ~TerminalCommands();

@@ -91,18 +91,27 @@ int main(int argc, char** argv) {
   }
   AckWaiter waiter;
   waiter.source = source;
-  subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &waiter);
+  // Checked: a malformed acknowledgement on the bus is counted and ignored, never decoded blindly.
+  const CheckedSubscription acks = subscribe_to<vitreo_lcm::command_ack_t>(lc, kChanCommandAck, &waiter);
+  auto report_malformed = [&](int rc) {
+    if (const auto bad = acks.counters().rejected(); bad > 0) {
+      std::fprintf(stderr, "vitreo-cmd: ignored %llu malformed packet(s) on %s (%s)\n", static_cast<unsigned long long>(bad),
+                   kChanCommandAck, acks.counters().last_error().c_str());
+    }
+    return rc;
+  };
 
   if (!words.empty()) {
     std::string line;
     for (const auto& w : words) line += (line.empty() ? "" : " ") + w;
-    return send(lc, waiter, line, timeout_ms);
+    return report_malformed(send(lc, waiter, line, timeout_ms));
   }
   int worst = 0;
-  for (std::string line; std::getline(std::cin, line);) {
+  for (std::string line; std::getline(std::cin, line);) {  // the last line counts without its newline too
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     const int rc = send(lc, waiter, line, timeout_ms);
     worst = std::max(worst, rc);
   }
-  return worst;
+  return report_malformed(worst);
 }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <variant>
+#include <vector>
 
 #include "drivers/session.hpp"
 #include "firmware-protocol/vp.hpp"
@@ -74,7 +76,43 @@ TEST(Session, HandshakeStaleLostSequence) {
   EXPECT_EQ(h.s.state(), LinkState::reconnecting);
   h.s.transport_up(400'100);
   EXPECT_EQ(h.s.state(), LinkState::connecting);
-  EXPECT_EQ(h.s.stats().reconnects, 1u);
+  EXPECT_EQ(h.s.stats().reconnects, 0u) << "re-opening the transport is not finding the device";
+  h.info(400'200);
+  EXPECT_EQ(h.s.state(), LinkState::configuring);
+  EXPECT_EQ(h.s.stats().reconnects, 1u) << "the device identified itself again";
+}
+
+// Stuck = bit-identical poses for >= 50 ms of the device's own time (issue 20): not a number of
+// samples (a 250 Hz and a 1 kHz tracker alike), not repeats whose timestamps do not advance.
+TEST(Session, APoseIdenticalFor50MsOfDeviceTimeIsStuckAndMovingAgainEndsIt) {
+  Harness h;
+  std::vector<bool> flags;
+  h.s.set_on_sample([&](const Sample& x) { flags.push_back(std::get<PoseSample>(x).stuck); });
+  h.s.transport_up(1000);
+  h.info(2000);
+  h.ack(3000);
+  auto pose = [&](std::uint64_t now, std::uint64_t device_us, float x) {
+    vp_message m = make(VP_MSG_POSE_SAMPLE, h.seq++);
+    m.u.pose.timestamp_us = device_us;
+    m.u.pose.q_wxyz[0] = 1;
+    m.u.pose.tip_mm[0] = x;
+    h.s.on_frame(VP_OK, m, now);
+  };
+  // 4 ms apart (250 Hz): the same pose from device time 10 000 on.
+  for (int i = 0; i <= 20; ++i) pose(10'000 + 4000 * i, 5'000'000 + 4000 * i, 1.5f);
+  ASSERT_EQ(flags.size(), 21u);
+  for (int i = 0; i < 13; ++i) EXPECT_FALSE(flags[static_cast<std::size_t>(i)]) << "sample " << i << ": under 50 ms";
+  for (int i = 13; i <= 20; ++i) EXPECT_TRUE(flags[static_cast<std::size_t>(i)]) << "sample " << i << ": 52 ms or more";
+  EXPECT_TRUE(h.s.stuck());
+  EXPECT_EQ(h.s.stats().stuck_samples, 8u);
+  EXPECT_EQ(h.s.stats().stuck_episodes, 1u);
+  pose(100'000, 5'084'000, 1.50001f);  // it moved: no longer stuck
+  EXPECT_FALSE(flags.back());
+  EXPECT_FALSE(h.s.stuck());
+  // The same bits with a timestamp that does not advance are repeats of one sample, not 50 ms.
+  for (int i = 0; i < 100; ++i) pose(101'000 + 1000 * i, 5'090'000, 2.0f);
+  EXPECT_FALSE(h.s.stuck());
+  EXPECT_EQ(h.s.stats().stuck_episodes, 1u);
 }
 
 TEST(Session, RefusesDeviceWithOtherProtocolMajor) {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 
+#include "drivers/open_device.hpp"
 #include "drivers/sim/usb_sim.hpp"
 #include "drivers/usb.hpp"
 
@@ -148,6 +149,67 @@ TEST(UsbUmockdev, UnplugIsLostAndReplugStreamsAgain) {
   std::printf("after unplug/replug: %s (hotplug arrivals %llu, departures %llu)\n",
               to_string(b.driver.session().stats()).c_str(), (unsigned long long)b.driver.hotplug_arrivals(),
               (unsigned long long)b.driver.hotplug_departures());
+}
+
+// Two trackers of one kind on the bus: a URI with a serial number opens the one it names, also after
+// the other one was there first in the list, and after a re-plug finds that one again.
+TEST(UsbUmockdev, AUriWithASerialNumberOpensThatDeviceAndFindsItAgain) {
+  REQUIRE_UMOCKDEV();
+  sim::Script first, second;
+  std::string err;
+  ASSERT_TRUE(sim::parse_script("device tracker\nserial 4242\nkey 0 0 0 20 0 0 0 0\nkey 1000 1 0 20 0 0 0 0\n", first, &err)) << err;
+  ASSERT_TRUE(sim::parse_script("device tracker\nserial 5151\nkey 0 0 0 20 0 0 0 0\nkey 1000 1 0 20 0 0 0 0\n", second, &err)) << err;
+  sim::UsbSimDevice a(first, kTrackerPid, 5), b(second, kTrackerPid, 6);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.error() << b.error();
+  ManualClock clock;
+  std::unique_ptr<Device> d = open_device("usb:1209:7a11/5151", clock, {}, &err);
+  ASSERT_NE(d, nullptr) << err;
+  EXPECT_EQ(d->transport(), Transport::usb);
+  EXPECT_EQ(d->uri(), "usb:1209:7a11/5151");
+  auto run_ms = [&](int ms) {
+    for (int i = 0; i < ms; ++i) {
+      clock.advance_us(1000);
+      a.step(clock.now_us());
+      b.step(clock.now_us());
+      d->poll(0);
+    }
+  };
+  run_ms(300);
+  ASSERT_EQ(d->session().state(), LinkState::streaming);
+  EXPECT_EQ(d->session().device_info().serial, 5151u) << "the device the URI names, not the first of its kind";
+  EXPECT_EQ(a.emulator().counters().host_messages, 0u) << "the other tracker was never talked to";
+
+  b.unplug();
+  run_ms(100);
+  EXPECT_NE(d->session().state(), LinkState::streaming);
+  run_ms(300);
+  EXPECT_NE(d->session().state(), LinkState::streaming) << "with its device gone, the other tracker is not taken instead";
+  EXPECT_EQ(a.emulator().counters().host_messages, 0u);
+  b.plug();
+  for (int i = 0; i < 600 && d->session().state() != LinkState::streaming; ++i) run_ms(1);
+  EXPECT_EQ(d->session().state(), LinkState::streaming);
+  EXPECT_EQ(d->session().device_info().serial, 5151u);
+  EXPECT_EQ(d->session().stats().reconnects, 1u);
+}
+
+TEST(UsbUmockdev, ASimUriRunsItsEmulatorBehindAUmockdevDevice) {
+  REQUIRE_UMOCKDEV();
+  ManualClock clock;
+  OpenOptions o;
+  o.sim_script = "device pedals\nserial 2077\nrate_hz 500\nkey 0 0 0 0\nkey 400 0.5 0 0\n";
+  std::string err;
+  std::unique_ptr<Device> d = open_device("sim:pedals?transport=usb", clock, o, &err);
+  ASSERT_NE(d, nullptr) << err;
+  EXPECT_EQ(d->transport(), Transport::usb);
+  ASSERT_NE(d->simulated_peer(), nullptr);
+  for (int i = 0; i < 400 && d->session().stats().samples_delivered < 50; ++i) {
+    clock.advance_us(1000);
+    d->simulated_peer()->step(clock.now_us());
+    d->poll(0);
+  }
+  EXPECT_GE(d->session().stats().samples_delivered, 50u);
+  EXPECT_EQ(d->session().device_info().serial, 2077u);
+  EXPECT_EQ(d->session().device_info().device_type, VP_DEVICE_PEDAL);
 }
 
 }  // namespace

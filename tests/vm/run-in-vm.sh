@@ -10,7 +10,9 @@
 #                      monitor) and then sends the guest a line on its console ("dumped"), so the
 #                      guest can wait for it on stdin instead of guessing a delay
 #   EXTRA_BINS="..."   host programs copied to /bin with their shared libraries (can-utils)
+#   EXTRA_LIBS="..."   shared libraries copied to their own paths with theirs (LD_PRELOAD ones)
 #   EXTRA_FILES="..."  files copied to /data
+#   VM_MEM=MiB (256), VM_SMP=N (1)
 # Exit: the test's exit code; 124 timeout; 125 = could not run the VM (CTest SKIP_RETURN_CODE),
 # with the reason on stderr. Our own version of shared/recipes/can-vm/run-can-vm.sh.
 set -uo pipefail
@@ -49,6 +51,10 @@ for b in ${EXTRA_BINS:-}; do
   cp "$b" "$R/bin/"
   for l in $(ldd "$b" | grep -o '/[^ ]*'); do mkdir -p "$R$(dirname "$l")"; cp -L "$l" "$R$l"; done
 done
+for l in ${EXTRA_LIBS:-}; do
+  mkdir -p "$R$(dirname "$l")"; cp -L "$l" "$R$l"
+  for d in $(ldd "$l" | grep -o '/[^ ]*'); do mkdir -p "$R$(dirname "$d")"; cp -L "$d" "$R$d"; done
+done
 for f in ${EXTRA_FILES:-}; do cp "$f" "$R/data/"; done
 cp "$TEST_BIN" "$R/test"
 : > "$R/test.args"; [ $# -gt 0 ] && printf "%q " "$@" > "$R/test.args"
@@ -85,7 +91,7 @@ fi
 : > "$WORK/console.log"
 # TCG: KVM is unusable on these machines (PLATFORM-NOTES); -machine pc (microvm hangs under TCG);
 # -cpu max because the project builds for x86-64-v3 (AVX2), which the default qemu64 CPU lacks
-timeout "${TIMEOUT:-150}" qemu-system-x86_64 -machine pc -accel tcg -cpu max -m 256 -smp 1 -nographic -no-reboot \
+timeout "${TIMEOUT:-150}" qemu-system-x86_64 -machine pc -accel tcg -cpu max -m "${VM_MEM:-256}" -smp "${VM_SMP:-1}" -nographic -no-reboot \
   -kernel "$KERNEL" -initrd "$WORK/initramfs.cpio.gz" \
   -append "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init" \
   -nic none "${QEMU_IO[@]}" < "$STDIN" > "$WORK/console.log" 2>&1 &

@@ -38,11 +38,11 @@ std::uint64_t reload_after_copy(std::atomic_ref<std::uint64_t> lock) {
 
 }  // namespace
 
-FrameRingWriter::FrameRingWriter(std::string name, int eye_width, int height, int slot_count)
+FrameRingWriter::FrameRingWriter(std::string name, int eye_width, int height, int slot_count, int eyes)
     : name_(std::move(name)) {
-  if (eye_width <= 0 || height <= 0 || slot_count < 2)
-    throw std::invalid_argument("frame ring: need positive size and at least 2 slots");
-  const std::uint64_t frame_bytes = std::uint64_t(2 * eye_width) * std::uint64_t(height) * 4;
+  if (eye_width <= 0 || height <= 0 || slot_count < 2 || (eyes != 1 && eyes != 2))
+    throw std::invalid_argument("frame ring: need positive size, at least 2 slots and 1 or 2 eyes");
+  const std::uint64_t frame_bytes = std::uint64_t(eyes * eye_width) * std::uint64_t(height) * 4;
   const std::uint64_t stride = (sizeof(FrameSlotHeader) + frame_bytes + 63) / 64 * 64;
   bytes_ = sizeof(FrameRingHeader) + stride * std::uint64_t(slot_count);
   shm_unlink(name_.c_str());  // a stale ring from a crashed run
@@ -65,7 +65,7 @@ FrameRingWriter::FrameRingWriter(std::string name, int eye_width, int height, in
   auto& h = *reinterpret_cast<FrameRingHeader*>(base_);
   h.version = kFrameRingVersion;
   h.header_bytes = sizeof(FrameRingHeader);
-  h.width = static_cast<std::uint32_t>(2 * eye_width);
+  h.width = static_cast<std::uint32_t>(eyes * eye_width);
   h.height = static_cast<std::uint32_t>(height);
   h.eye_width = static_cast<std::uint32_t>(eye_width);
   h.format = kFrameFormatRgba8;
@@ -81,6 +81,14 @@ FrameRingWriter::FrameRingWriter(std::string name, int eye_width, int height, in
 FrameRingWriter::~FrameRingWriter() {
   if (base_ != nullptr) munmap(base_, bytes_);
   shm_unlink(name_.c_str());
+}
+
+void FrameRingWriter::write(const Image& image, double sim_time_s, std::uint64_t step_index, std::uint64_t frame_index) {
+  const auto& h = *reinterpret_cast<const FrameRingHeader*>(base_);
+  if (static_cast<std::uint32_t>(image.width) != h.width || static_cast<std::uint32_t>(image.height) != h.height ||
+      image.rgba.size() != h.frame_bytes)
+    throw std::invalid_argument("frame ring: image size differs from the ring's");
+  write(image.rgba.data(), sim_time_s, step_index, frame_index);
 }
 
 void FrameRingWriter::write(const StereoFrame& frame) {

@@ -6,6 +6,7 @@
 #include <future>
 
 #include "vitreo/render/frame_ring.hpp"
+#include "vitreo/render/instructor_view.hpp"
 #include "vitreo/render/png_io.hpp"
 
 namespace vitreo::render {
@@ -27,7 +28,7 @@ RenderThread::RenderThread(RenderThreadOptions options) : options_(std::move(opt
 RenderThread::~RenderThread() { stop(); }
 
 void RenderThread::publish(FrameScene scene) {
-  mailbox_.publish(std::move(scene));
+  mailbox_.write(std::move(scene));
   // Wakes the render thread if it sleeps on wake_; a notify is a syscall at most, never a wait.
   wake_.fetch_add(1, std::memory_order_release);
   wake_.notify_one();
@@ -52,10 +53,11 @@ std::vector<std::string> RenderThread::pngs_written() const {
 }
 
 namespace {
-void write_stereo_pngs(const std::string& prefix, const StereoFrame& frame) {
+void write_stereo_pngs(const std::string& prefix, const StereoFrame& frame, const Image* instructor) {
   write_png(prefix + "_left.png", frame.eye(0));
   write_png(prefix + "_right.png", frame.eye(1));
   write_png(prefix + "_stereo.png", frame.side_by_side());
+  if (instructor) write_png(prefix + "_instructor.png", *instructor);
 }
 
 std::string series_prefix(const std::string& dir, std::uint64_t step) {
@@ -89,7 +91,7 @@ std::optional<std::string> RenderThread::error() const {
 void RenderThread::run(std::promise<void>& started) {
   std::unique_ptr<EglContext> context;
   std::unique_ptr<StereoRenderer> renderer;
-  std::unique_ptr<FrameRingWriter> ring;
+  std::unique_ptr<FrameRingWriter> ring, instructor_ring;
   std::vector<std::unique_ptr<KmsDisplay>> displays;
   try {
     context = std::make_unique<EglContext>(options_.egl);
@@ -97,6 +99,9 @@ void RenderThread::run(std::promise<void>& started) {
     if (!options_.shm_ring_name.empty())
       ring = std::make_unique<FrameRingWriter>(options_.shm_ring_name, options_.render.eye_width,
                                                options_.render.eye_height, options_.shm_ring_slots);
+    if (!options_.instructor_ring_name.empty())
+      instructor_ring = std::make_unique<FrameRingWriter>(options_.instructor_ring_name, options_.render.eye_width,
+                                                          options_.render.eye_height, options_.shm_ring_slots, 1);
     for (const KmsOptions& d : options_.displays) {
       displays.push_back(std::make_unique<KmsDisplay>(d));
       display_descriptions_.push_back(displays.back()->description());
@@ -113,6 +118,8 @@ void RenderThread::run(std::promise<void>& started) {
   spdlog::info("render thread: {}", context_description_);
 
   StereoFrame frame;
+  Image instructor;
+  const bool instructor_wanted = !options_.instructor_ring_name.empty() || !options_.png_dir.empty();
   try {
     for (;;) {
       const std::uint64_t wake = wake_.load(std::memory_order_acquire);
@@ -125,17 +132,22 @@ void RenderThread::run(std::promise<void>& started) {
       }
       renderer->render(*scene, frame);
       if (ring) ring->write(frame);
+      if (instructor_wanted) {
+        instructor = compose_instructor_view(frame, scene->instructor ? *scene->instructor : InstructorOverlay{});
+        if (instructor_ring) instructor_ring->write(instructor, frame.sim_time_s, frame.step_index, frame.frame_index);
+      }
+      const Image* instructor_png = instructor_wanted && !options_.png_dir.empty() ? &instructor : nullptr;
       present_on_displays(frame, displays);
       std::string prefix;
       {
         std::lock_guard lock(mutex_);
         prefix.swap(png_prefix_);
       }
-      if (!prefix.empty()) write_stereo_pngs(prefix, frame);
+      if (!prefix.empty()) write_stereo_pngs(prefix, frame, instructor_wanted ? &instructor : nullptr);
       const std::uint64_t n = frames_.load(std::memory_order_relaxed) + 1;
       if (!options_.png_dir.empty() && options_.png_every_frames > 0 && n % options_.png_every_frames == 0) {
         const std::string p = series_prefix(options_.png_dir, frame.step_index);
-        write_stereo_pngs(p, frame);
+        write_stereo_pngs(p, frame, instructor_png);
         std::lock_guard lock(mutex_);
         pngs_written_.push_back(p);
       }
@@ -149,7 +161,7 @@ void RenderThread::run(std::promise<void>& started) {
       const std::string p = series_prefix(options_.png_dir, frame.step_index);
       std::lock_guard lock(mutex_);
       if (pngs_written_.empty() || pngs_written_.back() != p) {
-        write_stereo_pngs(p, frame);
+        write_stereo_pngs(p, frame, instructor_wanted ? &instructor : nullptr);
         pngs_written_.push_back(p);
       }
       spdlog::info("render thread: {} stereo frame(s) written to {} (last: {}_stereo.png)", pngs_written_.size(),
@@ -161,6 +173,7 @@ void RenderThread::run(std::promise<void>& started) {
     error_ = e.what();
   }
   ring.reset();
+  instructor_ring.reset();
   displays.clear();
   renderer.reset();
   context.reset();

@@ -11,6 +11,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "bitmap_font.hpp"
 #include "shaders.hpp"
 #include "vitreo/render/camera.hpp"
 
@@ -20,14 +21,18 @@ Appearance default_appearance(MaterialKind kind, bool detached) {
   switch (kind) {
     case MaterialKind::Retina:
       // Attached retina is nearly transparent (the choroid shows through); detached retina turns
-      // greyish-white and translucent (oedema), as surgeons see a bullous detachment.
-      return detached ? Appearance{{0.82f, 0.80f, 0.78f}, 0.78f, 0.35f, 40.0f, true}
+      // grey and translucent (oedema, with the yellowish subretinal fluid under it), as surgeons
+      // see a bullous detachment.
+      return detached ? Appearance{{0.62f, 0.61f, 0.57f}, 0.78f, 0.35f, 40.0f, true}
                       : Appearance{{0.95f, 0.80f, 0.70f}, 0.10f, 0.25f, 40.0f, false};
     case MaterialKind::Choroid: return {{0.80f, 0.32f, 0.16f}, 1.0f, 0.10f, 20.0f, false};
     case MaterialKind::Static: return {{0.92f, 0.90f, 0.86f}, 1.0f, 0.15f, 20.0f, false};
-    case MaterialKind::Membrane: return {{0.92f, 0.92f, 0.88f}, 0.60f, 0.30f, 30.0f, true};
-    case MaterialKind::Gel: return {{0.85f, 0.87f, 0.90f}, 0.07f, 0.05f, 10.0f, false};
+    // White-grey and glistening (a sharp, strong highlight), translucent enough to show what is under it.
+    case MaterialKind::Membrane: return {{0.80f, 0.80f, 0.78f}, 0.66f, 0.75f, 90.0f, true};
+    case MaterialKind::Gel: return {{0.86f, 0.88f, 0.90f}, 0.05f, 0.0f, 10.0f, false};
     case MaterialKind::Instrument: return {{0.62f, 0.63f, 0.66f}, 1.0f, 0.9f, 60.0f, true};
+    case MaterialKind::Guide: return {{1.00f, 0.86f, 0.25f}, 0.85f, 0.0f, 1.0f, false};
+    case MaterialKind::Glow: return {{1.0f, 1.0f, 1.0f}, 1.0f, 0.0f, 1.0f, false};
   }
   return {{1, 1, 1}, 1.0f, 0.0f, 1.0f, false};
 }
@@ -137,6 +142,12 @@ struct Texture {
   std::uint64_t last_used = 0;
 };
 
+struct BurnSpot {
+  Vec2 uv;
+  float g00 = 0, g01 = 0, g11 = 0;  // surface metric at the hit
+  bool found = false;
+};
+
 struct GpuMesh {
   GLuint vao = 0, vbo = 0, ibo = 0;
   std::size_t vbo_bytes = 0, ibo_bytes = 0;
@@ -147,7 +158,8 @@ struct GpuMesh {
   bool uploaded = false;
   Vec3 bbox_min, bbox_max;
   GLuint burn_texture = 0, burn_fbo = 0;
-  std::size_t burns_painted = 0;
+  std::vector<BurnSpot> burn_spots;  // per burn of the mesh, located once
+  std::size_t burns_mature = 0;      // burns [0, this) are fully white and never painted again
   std::uint64_t last_used = 0;
 };
 
@@ -162,27 +174,40 @@ struct DrawItem {
 
 struct StereoRenderer::Impl {
   RenderSettings s;
-  static constexpr std::uint32_t kLight = 1u << 3, kShadows = 1u << 4, kGas = 1u << 5, kTexture = 1u << 6,
-                                 kBurns = 1u << 7;
+  // Shader variant key: the material in the low 4 bits, then one bit per feature define.
+  static constexpr std::uint32_t kLight = 1u << 4, kShadows = 1u << 5, kGas = 1u << 6, kTexture = 1u << 7,
+                                 kBurns = 1u << 8, kFlat = 1u << 9, kLight2 = 1u << 10;
+  static constexpr int kDiscMaterial = 8;  // the fluid–gas interface (the renderer's own geometry)
   std::unordered_map<std::uint32_t, GLuint> scene_programs;  // shader variant by feature key
   std::unordered_map<GLuint, std::uint64_t> globals_stamp;    // eye_stamp when its globals were set
   std::uint64_t eye_stamp = 0;
-  GLuint shadow_program = 0, burn_program = 0;
+  GLuint shadow_program = 0, burn_program = 0, text_program = 0;
 
   GLuint scene_program(std::uint32_t key) {
     auto it = scene_programs.find(key);
     if (it != scene_programs.end()) return it->second;
-    const std::string src = "#version 450 core\n#define MATERIAL " + std::to_string(key & 7u) +
-                            "\n#define LIGHT " + std::to_string((key & kLight) ? 1 : 0) +
-                            "\n#define SHADOWS " + std::to_string((key & kShadows) ? 1 : 0) +
-                            "\n#define GAS " + std::to_string((key & kGas) ? 1 : 0) +
-                            "\n#define TEXTURE " + std::to_string((key & kTexture) ? 1 : 0) +
-                            "\n#define BURNS " + std::to_string((key & kBurns) ? 1 : 0) + "\n" +
-                            shaders::kSceneFragmentBody;
-    const GLuint p = link(shaders::kSceneVertex, src.c_str());
+    shaders::FragmentVariant v;
+    v.material = static_cast<int>(key & 15u);
+    v.light = (key & kLight) != 0;
+    v.shadows = (key & kShadows) != 0;
+    v.light2 = (key & kLight2) != 0;
+    v.gas = (key & kGas) != 0;
+    v.texture = (key & kTexture) != 0;
+    v.burns = (key & kBurns) != 0;
+    v.flat = (key & kFlat) != 0;
+    const GLuint p = link(shaders::kSceneVertex, shaders::scene_fragment_source(v).c_str());
     scene_programs.emplace(key, p);
     return p;
   }
+  // Labels: the glyph atlas and a stream of quads rebuilt per eye.
+  GLuint atlas_tex = 0, text_vao = 0, text_vbo = 0;
+  std::size_t text_vbo_bytes = 0;
+  struct TextVertex {
+    float x, y, u, v, r, g, b, a;
+  };
+  std::vector<TextVertex> text_quads;
+  std::vector<float> label_offsets;
+  std::vector<std::array<float, 4>> label_boxes;
   GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
   GLuint shadow_fbo = 0, shadow_tex = 0;
   // Depth of field: the eyes are drawn into textures, then composited into `fbo` (made on first use).
@@ -217,8 +242,9 @@ struct StereoRenderer::Impl {
   GpuMesh disc;  // the fluid–gas interface, rebuilt each frame it is shown
   std::unordered_map<std::uint32_t, GpuMesh> meshes;
   std::unordered_map<const Image*, Texture> textures;
+  std::vector<std::uint8_t> premultiplied;  // upload scratch
   std::uint64_t frame = 0;
-  std::vector<DrawItem> opaque, translucent;
+  std::vector<DrawItem> opaque, translucent, glows;
   // Uniform locations by program and name; the names are string literals, so their addresses
   // are stable keys and a lookup costs no string work.
   std::unordered_map<GLuint, std::unordered_map<const char*, GLint>> uniform_cache;
@@ -244,8 +270,34 @@ struct StereoRenderer::Impl {
       scene_program(m | kLight | kShadows | kTexture);
       scene_program(m | kLight | kShadows);
     }
+    scene_program(static_cast<std::uint32_t>(MaterialKind::Guide));
+    scene_program(static_cast<std::uint32_t>(MaterialKind::Glow));
     shadow_program = link(shaders::kShadowVertex, shaders::kShadowFragment);
     burn_program = link(shaders::kBurnVertex, shaders::kBurnFragment);
+    text_program = link(shaders::kTextVertex, shaders::kTextFragment);
+    {
+      const Image a = font::atlas();
+      glGenTextures(1, &atlas_tex);
+      glBindTexture(GL_TEXTURE_2D, atlas_tex);
+      glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, a.width, a.height);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a.width, a.height, GL_RGBA, GL_UNSIGNED_BYTE, a.rgba.data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);  // crisp pixels at integer scales
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glGenVertexArrays(1, &text_vao);
+      glBindVertexArray(text_vao);
+      glGenBuffers(1, &text_vbo);
+      glBindBuffer(GL_ARRAY_BUFFER, text_vbo);
+      glEnableVertexAttribArray(0);
+      glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(TextVertex), reinterpret_cast<void*>(offsetof(TextVertex, x)));
+      glEnableVertexAttribArray(1);
+      glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(TextVertex), reinterpret_cast<void*>(offsetof(TextVertex, u)));
+      glEnableVertexAttribArray(2);
+      glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(TextVertex), reinterpret_cast<void*>(offsetof(TextVertex, r)));
+      glBindVertexArray(0);
+    }
 
     // Both eyes share one framebuffer, side by side, so one glReadPixels returns the stereo pair.
     glGenFramebuffers(1, &fbo);
@@ -307,6 +359,10 @@ struct StereoRenderer::Impl {
     for (auto& [key, prog] : scene_programs) glDeleteProgram(prog);
     glDeleteProgram(shadow_program);
     glDeleteProgram(burn_program);
+    glDeleteProgram(text_program);
+    glDeleteTextures(1, &atlas_tex);
+    glDeleteVertexArrays(1, &text_vao);
+    glDeleteBuffers(1, &text_vbo);
     glDeleteFramebuffers(1, &fbo);
     glDeleteRenderbuffers(1, &colour_rb);
     glDeleteRenderbuffers(1, &depth_rb);
@@ -339,6 +395,8 @@ struct StereoRenderer::Impl {
       glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
       glEnableVertexAttribArray(3);
       glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, detachment)));
+      glEnableVertexAttribArray(4);
+      glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, highlight)));
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ibo);
       glBindVertexArray(0);
     }
@@ -390,7 +448,15 @@ struct StereoRenderer::Impl {
       const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(img->width, img->height))));
       glTexStorage2D(GL_TEXTURE_2D, levels, GL_RGBA8, img->width, img->height);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, img->width, img->height, GL_RGBA, GL_UNSIGNED_BYTE, img->rgba.data());
+      // Premultiplied alpha: mipmaps of straight-alpha coverage maps (vessels on a transparent
+      // sheet) average the invisible texels' colour in and wash thin vessels out to pink.
+      premultiplied.resize(img->rgba.size());
+      for (std::size_t i = 0; i < img->rgba.size(); i += 4) {
+        const unsigned a = img->rgba[i + 3];
+        for (int k = 0; k < 3; ++k) premultiplied[i + k] = static_cast<std::uint8_t>((img->rgba[i + k] * a + 127) / 255);
+        premultiplied[i + 3] = static_cast<std::uint8_t>(a);
+      }
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, img->width, img->height, GL_RGBA, GL_UNSIGNED_BYTE, premultiplied.data());
       glGenerateMipmap(GL_TEXTURE_2D);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -403,17 +469,92 @@ struct StereoRenderer::Impl {
     return it->second.id;
   }
 
-  // Paints burns[g.burns_painted..] of `mesh` into its burn texture.
-  void paint_burns(const Mesh& mesh, GpuMesh& g, RenderStats& stats) {
-    if (mesh.burns.size() < g.burns_painted) {  // the list shrank: a new case; start clean
-      g.burns_painted = 0;
+  // Where a burn lies in the mesh's uv space: the triangle under the hit, its uv there and the
+  // surface metric JᵀJ (mm² per uv²). Found once per burn (uv is where the tissue lies at rest).
+  BurnSpot locate_burn(const Mesh& mesh, const LaserBurn& burn) {
+    const MeshGeometry& geo = *mesh.geometry;
+    const Mat4 inv_model = rigid_inverse(mesh.model);
+    // The triangle under the hit, its uv there and the surface metric JᵀJ (mm² per uv²).
+    Vec2 uv{};
+    float g00 = 0, g01 = 0, g11 = 0;
+    bool found = false;
+    const std::size_t tris = geo.indices.size() / 3;
+    const auto on_triangle = [&](const Vertex& va, const Vertex& vb, const Vertex& vc, const std::array<float, 3>& bc) {
+      uv = {va.uv.x * bc[0] + vb.uv.x * bc[1] + vc.uv.x * bc[2], va.uv.y * bc[0] + vb.uv.y * bc[1] + vc.uv.y * bc[2]};
+      // J = E · T⁻¹ with E = [b−a, c−a] (3×2) and T = [uv_b−uv_a, uv_c−uv_a] (2×2).
+      const Vec3 e1 = vb.position_mm - va.position_mm, e2 = vc.position_mm - va.position_mm;
+      const float t00 = vb.uv.x - va.uv.x, t10 = vb.uv.y - va.uv.y;
+      const float t01 = vc.uv.x - va.uv.x, t11 = vc.uv.y - va.uv.y;
+      const float det = t00 * t11 - t01 * t10;
+      if (std::fabs(det) <= 1e-12f) return;
+      const float i00 = t11 / det, i01 = -t01 / det, i10 = -t10 / det, i11 = t00 / det;
+      const Vec3 j0 = e1 * i00 + e2 * i10;  // d position / du
+      const Vec3 j1 = e1 * i01 + e2 * i11;  // d position / dv
+      g00 = dot(j0, j0);
+      g01 = dot(j0, j1);
+      g11 = dot(j1, j1);
+      found = true;
+    };
+    if (burn.hit_point) {
+      // Surface coordinates from the simulation: the triangle and the point in it, no search.
+      const auto& c = burn.hit_point->corners;
+      if (c[0] < geo.vertices.size() && c[1] < geo.vertices.size() && c[2] < geo.vertices.size()) {
+        on_triangle(geo.vertices[c[0]], geo.vertices[c[1]], geo.vertices[c[2]], burn.hit_point->barycentric);
+      }
+    } else if (burn.hit_position_mm) {
+      // Only a point: the nearest triangle of the current surface.
+      const Vec3 p = inv_model.transform_point(*burn.hit_position_mm);
+      float best = std::numeric_limits<float>::max();
+      std::size_t best_t = 0;
+      std::array<float, 3> best_bc{};
+      for (std::size_t t = 0; t < tris; ++t) {
+        const Vec3 a = geo.vertices[geo.indices[3 * t]].position_mm;
+        const Vec3 bb = geo.vertices[geo.indices[3 * t + 1]].position_mm;
+        const Vec3 c = geo.vertices[geo.indices[3 * t + 2]].position_mm;
+        const auto bc = closest_barycentric(p, a, bb, c);
+        const Vec3 q = a * bc[0] + bb * bc[1] + c * bc[2];
+        const float d = dot(q - p, q - p);
+        if (d < best) { best = d; best_t = t; best_bc = bc; }
+      }
+      if (tris > 0 && best <= 0.25f) {
+        on_triangle(geo.vertices[geo.indices[3 * best_t]], geo.vertices[geo.indices[3 * best_t + 1]],
+                    geo.vertices[geo.indices[3 * best_t + 2]], best_bc);
+      }
+    } else if (burn.hit_uv) {
+      uv = *burn.hit_uv;
+      // Without a hit triangle, use the metric of the triangle whose uv footprint contains it.
+      for (std::size_t t = 0; t < tris && !found; ++t) {
+        const Vertex& va = geo.vertices[geo.indices[3 * t]];
+        const Vertex& vb = geo.vertices[geo.indices[3 * t + 1]];
+        const Vertex& vc = geo.vertices[geo.indices[3 * t + 2]];
+        const float t00 = vb.uv.x - va.uv.x, t10 = vb.uv.y - va.uv.y;
+        const float t01 = vc.uv.x - va.uv.x, t11 = vc.uv.y - va.uv.y;
+        const float det = t00 * t11 - t01 * t10;
+        if (std::fabs(det) <= 1e-12f) continue;
+        const float du = uv.x - va.uv.x, dv = uv.y - va.uv.y;
+        const float l1 = (t11 * du - t01 * dv) / det, l2 = (-t10 * du + t00 * dv) / det;
+        if (l1 < -1e-4f || l2 < -1e-4f || l1 + l2 > 1.0001f) continue;
+        const Vec2 keep = uv;
+        on_triangle(va, vb, vc, {1.0f - l1 - l2, l1, l2});
+        uv = keep;
+      }
+    }
+    return BurnSpot{uv, g00, g01, g11, found && burn.radius_mm > 0 && g00 * g11 - g01 * g01 > 0};
+  }
+
+  // Paints the burns of `mesh` that are still whitening (and new ones) into its burn texture, each
+  // as white as its age makes it (the texture keeps the maximum, so whitening only adds).
+  void paint_burns(const Mesh& mesh, GpuMesh& g, float whitening_s, RenderStats& stats) {
+    if (mesh.burns.size() < g.burn_spots.size()) {  // the list shrank: a new case; start clean
+      g.burns_mature = 0;
+      g.burn_spots.clear();
       if (g.burn_fbo) {
         glBindFramebuffer(GL_FRAMEBUFFER, g.burn_fbo);
         glClearColor(0, 0, 0, 0);
         glClear(GL_COLOR_BUFFER_BIT);
       }
     }
-    if (mesh.burns.size() == g.burns_painted) return;
+    if (mesh.burns.size() == g.burns_mature) return;
     const int size = s.burn_texture_size;
     if (g.burn_texture == 0) {
       glGenTextures(1, &g.burn_texture);
@@ -433,98 +574,38 @@ struct StereoRenderer::Impl {
     glViewport(0, 0, size, size);
     glDisable(GL_DEPTH_TEST);
     glEnable(GL_BLEND);
-    glBlendEquation(GL_MAX);  // overlapping burns do not add up beyond white
+    glBlendEquation(GL_MAX);  // overlapping burns do not add up beyond white; a whitening burn only brightens
     glUseProgram(burn_program);
     glBindVertexArray(burn_vao);
-    const MeshGeometry& geo = *mesh.geometry;
-    const Mat4 inv_model = rigid_inverse(mesh.model);
-    for (std::size_t b = g.burns_painted; b < mesh.burns.size(); ++b) {
+    const float tau = std::max(whitening_s, 1e-3f);
+    for (std::size_t b = g.burns_mature; b < mesh.burns.size(); ++b) {
       const LaserBurn& burn = mesh.burns[b];
-      // Find the triangle under the hit, its uv there and the surface metric JᵀJ (mm² per uv²).
-      Vec2 uv{};
-      float g00 = 0, g01 = 0, g11 = 0;
-      bool found = false;
-      const std::size_t tris = geo.indices.size() / 3;
-      if (burn.hit_position_mm) {
-        const Vec3 p = inv_model.transform_point(*burn.hit_position_mm);
-        float best = std::numeric_limits<float>::max();
-        std::size_t best_t = 0;
-        std::array<float, 3> best_bc{};
-        for (std::size_t t = 0; t < tris; ++t) {
-          const Vec3 a = geo.vertices[geo.indices[3 * t]].position_mm;
-          const Vec3 bb = geo.vertices[geo.indices[3 * t + 1]].position_mm;
-          const Vec3 c = geo.vertices[geo.indices[3 * t + 2]].position_mm;
-          const auto bc = closest_barycentric(p, a, bb, c);
-          const Vec3 q = a * bc[0] + bb * bc[1] + c * bc[2];
-          const float d = dot(q - p, q - p);
-          if (d < best) { best = d; best_t = t; best_bc = bc; }
-        }
-        if (tris > 0 && best <= 0.25f) {
-          const Vertex& va = geo.vertices[geo.indices[3 * best_t]];
-          const Vertex& vb = geo.vertices[geo.indices[3 * best_t + 1]];
-          const Vertex& vc = geo.vertices[geo.indices[3 * best_t + 2]];
-          uv = {va.uv.x * best_bc[0] + vb.uv.x * best_bc[1] + vc.uv.x * best_bc[2],
-                va.uv.y * best_bc[0] + vb.uv.y * best_bc[1] + vc.uv.y * best_bc[2]};
-          // J = E · T⁻¹ with E = [b−a, c−a] (3×2) and T = [uv_b−uv_a, uv_c−uv_a] (2×2).
-          const Vec3 e1 = vb.position_mm - va.position_mm, e2 = vc.position_mm - va.position_mm;
-          const float t00 = vb.uv.x - va.uv.x, t10 = vb.uv.y - va.uv.y;
-          const float t01 = vc.uv.x - va.uv.x, t11 = vc.uv.y - va.uv.y;
-          const float det = t00 * t11 - t01 * t10;
-          if (std::fabs(det) > 1e-12f) {
-            const float i00 = t11 / det, i01 = -t01 / det, i10 = -t10 / det, i11 = t00 / det;
-            const Vec3 j0 = e1 * i00 + e2 * i10;  // d position / du
-            const Vec3 j1 = e1 * i01 + e2 * i11;  // d position / dv
-            g00 = dot(j0, j0);
-            g01 = dot(j0, j1);
-            g11 = dot(j1, j1);
-            found = true;
-          }
-        }
-      } else if (burn.hit_uv) {
-        uv = *burn.hit_uv;
-        // Without a hit triangle, use the metric of the triangle whose uv footprint contains it.
-        for (std::size_t t = 0; t < tris && !found; ++t) {
-          const Vertex& va = geo.vertices[geo.indices[3 * t]];
-          const Vertex& vb = geo.vertices[geo.indices[3 * t + 1]];
-          const Vertex& vc = geo.vertices[geo.indices[3 * t + 2]];
-          const float t00 = vb.uv.x - va.uv.x, t10 = vb.uv.y - va.uv.y;
-          const float t01 = vc.uv.x - va.uv.x, t11 = vc.uv.y - va.uv.y;
-          const float det = t00 * t11 - t01 * t10;
-          if (std::fabs(det) <= 1e-12f) continue;
-          const float du = uv.x - va.uv.x, dv = uv.y - va.uv.y;
-          const float l1 = (t11 * du - t01 * dv) / det, l2 = (-t10 * du + t00 * dv) / det;
-          if (l1 < -1e-4f || l2 < -1e-4f || l1 + l2 > 1.0001f) continue;
-          const Vec3 e1 = vb.position_mm - va.position_mm, e2 = vc.position_mm - va.position_mm;
-          const float i00 = t11 / det, i01 = -t01 / det, i10 = -t10 / det, i11 = t00 / det;
-          const Vec3 j0 = e1 * i00 + e2 * i10, j1 = e1 * i01 + e2 * i11;
-          g00 = dot(j0, j0);
-          g01 = dot(j0, j1);
-          g11 = dot(j1, j1);
-          found = true;
-        }
+      if (b == g.burn_spots.size()) {
+        g.burn_spots.push_back(locate_burn(mesh, burn));
+        ++(g.burn_spots.back().found ? stats.burns_painted : stats.burns_missed);
       }
-      if (!found || burn.radius_mm <= 0) {
-        ++stats.burns_missed;
-        continue;
-      }
+      const BurnSpot& spot = g.burn_spots[b];
+      if (!spot.found) continue;
+      // Coagulation greys the retina over a few hundred milliseconds: 95 % white at whitening_s.
+      const float whiteness = burn.age_s >= tau ? 1.0f : 1.0f - std::exp(-3.0f * std::max(burn.age_s, 0.0f) / tau);
       // Footprint of {d : dᵀGd ≤ r²}: half extents r·sqrt(diag(G⁻¹)), plus a texel of margin.
-      const float det_g = g00 * g11 - g01 * g01;
-      if (det_g <= 0) {
-        ++stats.burns_missed;
-        continue;
-      }
+      const float det_g = spot.g00 * spot.g11 - spot.g01 * spot.g01;
       const float r = burn.radius_mm;
       const float margin = 2.0f / static_cast<float>(size);
-      const float hx = r * std::sqrt(g11 / det_g) + margin, hy = r * std::sqrt(g00 / det_g) + margin;
-      glUniform2f(loc(burn_program, "u_centre_uv"), uv.x, uv.y);
+      const float hx = r * std::sqrt(spot.g11 / det_g) + margin, hy = r * std::sqrt(spot.g00 / det_g) + margin;
+      glUniform2f(loc(burn_program, "u_centre_uv"), spot.uv.x, spot.uv.y);
       glUniform2f(loc(burn_program, "u_half_extent_uv"), hx, hy);
-      const float metric[4] = {g00, g01, g01, g11};
+      const float metric[4] = {spot.g00, spot.g01, spot.g01, spot.g11};
       glUniformMatrix2fv(loc(burn_program, "u_metric"), 1, GL_FALSE, metric);
       set(burn_program, "u_radius_mm", r);
+      set(burn_program, "u_whiteness", whiteness);
       glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-      ++stats.burns_painted;
     }
-    g.burns_painted = mesh.burns.size();
+    // Burns that are fully white (or missed) are done for good.
+    while (g.burns_mature < mesh.burns.size() && g.burns_mature < g.burn_spots.size() &&
+           (!g.burn_spots[g.burns_mature].found || mesh.burns[g.burns_mature].age_s >= tau)) {
+      ++g.burns_mature;
+    }
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_BLEND);
     glBindVertexArray(0);
@@ -565,6 +646,101 @@ struct StereoRenderer::Impl {
     glDrawElements(GL_TRIANGLES, item.gpu->index_count, GL_UNSIGNED_INT, nullptr);
   }
 
+  // Text and markers of the labels for one eye, as screen-space quads (pixels, rows from the top).
+  void add_text_quad(float x0, float y0, float x1, float y1, float u0, float v0, float u1, float v1, Vec3 c, float a) {
+    const TextVertex q[6] = {{x0, y0, u0, v0, c.x, c.y, c.z, a}, {x1, y0, u1, v0, c.x, c.y, c.z, a},
+                             {x1, y1, u1, v1, c.x, c.y, c.z, a}, {x0, y0, u0, v0, c.x, c.y, c.z, a},
+                             {x1, y1, u1, v1, c.x, c.y, c.z, a}, {x0, y1, u0, v1, c.x, c.y, c.z, a}};
+    text_quads.insert(text_quads.end(), q, q + 6);
+  }
+  void add_text(const std::string& text, float x, float y, float scale, Vec3 colour, float alpha) {
+    const float aw = static_cast<float>(font::kAtlasCell * font::kAtlasChars), ah = static_cast<float>(font::kAtlasCell);
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      int c = static_cast<unsigned char>(text[i]);
+      if (c >= 'a' && c <= 'z') c -= 'a' - 'A';
+      if (c < font::kAtlasFirst || c >= font::kAtlasFirst + font::kAtlasChars) c = '?';
+      const float cell = static_cast<float>((c - font::kAtlasFirst) * font::kAtlasCell);
+      const float gx = x + static_cast<float>(i * font::kAdvance) * scale;
+      // The glyph's 5×7 texels start one texel into its cell.
+      add_text_quad(gx, y, gx + font::kGlyphWidth * scale, y + font::kGlyphHeight * scale, (cell + 1) / aw, 1 / ah,
+                    (cell + 1 + font::kGlyphWidth) / aw, (1 + font::kGlyphHeight) / ah, colour, alpha);
+    }
+  }
+  void draw_labels(const FrameScene& scene, const StereoViews& views) {
+    if (scene.labels.empty()) return;
+    const float scale = static_cast<float>(std::max(1, s.eye_height / 400));
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(text_program);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, atlas_tex);
+    set(text_program, "u_atlas", 0);
+    glUniform2f(loc(text_program, "u_eye_size"), static_cast<float>(s.eye_width), static_cast<float>(s.eye_height));
+    glBindVertexArray(text_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, text_vbo);
+    // Where each label's text goes: to the right of its marker, moved down a line at a time while it
+    // would cover an earlier label (placed in the left eye, the same offsets in both eyes so the
+    // two pictures still fuse).
+    auto project = [&](int e, const Label& l, float& px, float& py) {
+      const Vec4 c = views.eye[e].view_projection * Vec4{l.anchor_mm.x, l.anchor_mm.y, l.anchor_mm.z, 1.0f};
+      if (c.w <= 1e-4f) return false;  // behind the eye
+      // Projected like the scene (so the label carries the anchor's disparity), rows from the top.
+      px = (c.x / c.w * 0.5f + 0.5f) * static_cast<float>(s.eye_width);
+      py = (0.5f - c.y / c.w * 0.5f) * static_cast<float>(s.eye_height);
+      return px > -200 && px < s.eye_width + 200 && py > -50 && py < s.eye_height + 50;
+    };
+    const float m = 2.0f * scale, line = (font::kGlyphHeight + 3) * scale;
+    label_offsets.assign(scene.labels.size(), 0.0f);
+    label_boxes.clear();
+    for (std::size_t i = 0; i < scene.labels.size(); ++i) {
+      float px = 0, py = 0;
+      if (!project(0, scene.labels[i], px, py)) continue;
+      // The box: from the marker to a glyph's width past the text, so neighbours keep a gap.
+      const float x0 = px - m - scale, w = static_cast<float>(font::text_width(scene.labels[i].text, static_cast<int>(scale)));
+      const float x1 = px + 3.0f * m + w + font::kAdvance * scale;
+      float y0 = py - 0.5f * font::kGlyphHeight * scale;
+      for (int tries = 0; tries < 8; ++tries) {
+        bool clear = true;
+        for (const auto& b : label_boxes) clear = clear && (x1 < b[0] || x0 > b[2] || y0 + line <= b[1] || y0 >= b[3]);
+        if (clear) break;
+        y0 += line;
+        label_offsets[i] += line;
+      }
+      label_boxes.push_back({x0, y0, x1, y0 + line});
+    }
+    for (int e = 0; e < 2; ++e) {
+      text_quads.clear();
+      for (std::size_t i = 0; i < scene.labels.size(); ++i) {
+        const Label& l = scene.labels[i];
+        float px = 0, py = 0;
+        if (!project(e, l, px, py)) continue;
+        // A marker on the structure (dark ring, bright dot), the name to its right (a leader line
+        // down to it when the name had to move).
+        add_text_quad(px - m - scale, py - m - scale, px + m + scale, py + m + scale, -1, 0, -1, 0, {0, 0, 0}, 0.6f);
+        add_text_quad(px - m, py - m, px + m, py + m, -1, 0, -1, 0, l.colour, 1.0f);
+        const float dy = label_offsets[i];
+        if (dy > 0.0f) add_text_quad(px + 0.5f * m, py, px + 0.5f * m + scale, py + dy, -1, 0, -1, 0, l.colour, 0.8f);
+        const float tx = px + 3.0f * m, ty = py - 0.5f * font::kGlyphHeight * scale + dy;
+        add_text(l.text, tx + scale, ty + scale, scale, {0, 0, 0}, 0.7f);  // drop shadow: legible on any tissue
+        add_text(l.text, tx, ty, scale, l.colour, 1.0f);
+      }
+      if (text_quads.empty()) continue;
+      const std::size_t bytes = text_quads.size() * sizeof(TextVertex);
+      if (bytes > text_vbo_bytes) {
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), text_quads.data(), GL_STREAM_DRAW);
+        text_vbo_bytes = bytes;
+      } else {
+        glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(bytes), text_quads.data());
+      }
+      glViewport(e * s.eye_width, 0, s.eye_width, s.eye_height);
+      glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(text_quads.size()));
+    }
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+  }
+
   void render(const FrameScene& scene, StereoFrame& out, RenderStats& stats);
 };
 
@@ -573,6 +749,7 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   // ---- 1. sync GPU state with the scene ----
   opaque.clear();
   translucent.clear();
+  glows.clear();
   std::uint64_t triangles = 0;
   for (const Mesh& mesh : scene.meshes) {
     if (!mesh.geometry) continue;
@@ -586,14 +763,18 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     g.geometry_version = mesh.geometry_version;
     g.topology_version = mesh.topology_version;
     g.last_used = frame;
-    paint_burns(mesh, g, stats);
+    paint_burns(mesh, g, scene.burn_whitening_s, stats);
     if (g.index_count == 0) continue;
     Appearance look = default_appearance(mesh.material, mesh.detached);
     look.base_colour = {look.base_colour.x * mesh.tint.x, look.base_colour.y * mesh.tint.y, look.base_colour.z * mesh.tint.z};
-    if (mesh.opacity >= 0) look.opacity = std::min(mesh.opacity, 1.0f);
+    if (mesh.opacity >= 0) look.opacity = mesh.material == MaterialKind::Glow ? mesh.opacity : std::min(mesh.opacity, 1.0f);
     if (mesh.casts_shadow) look.casts_shadow = *mesh.casts_shadow;
-    const bool blended = mesh.material == MaterialKind::Retina || look.opacity < 1.0f;
-    (blended ? translucent : opaque).push_back(DrawItem{&mesh, &g, look, 0.0f});
+    const bool blended = mesh.material == MaterialKind::Retina || mesh.material == MaterialKind::Guide || look.opacity < 1.0f;
+    if (mesh.material == MaterialKind::Glow) {
+      glows.push_back(DrawItem{&mesh, &g, look, 0.0f});
+    } else {
+      (blended ? translucent : opaque).push_back(DrawItem{&mesh, &g, look, 0.0f});
+    }
     triangles += static_cast<std::uint64_t>(g.index_count / 3);
   }
   // Meshes that left the scene (removed tissue, withdrawn instruments) free their GPU memory.
@@ -618,12 +799,15 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   for (const Mesh& m : scene.meshes)
     if (m.texture) texture_for(m.texture, stats);
 
-  // ---- 2. shadow map from the light-pipe tip ----
+  // ---- 2. shadow map from the primary light: the light pipe, else the chandelier ----
+  // (a chandelier beside a light pipe lights without shadows of its own: one map per frame).
+  const LightPipe* primary = scene.light_pipe ? &*scene.light_pipe : scene.chandelier ? &*scene.chandelier : nullptr;
+  const LightPipe* secondary = scene.light_pipe && scene.chandelier ? &*scene.chandelier : nullptr;
   Mat4 light_vp;
   bool shadows = false;
   Vec3 light_dir{0, 0, -1};
-  if (scene.light_pipe) {
-    const LightPipe& lp = *scene.light_pipe;
+  if (primary) {
+    const LightPipe& lp = *primary;
     light_dir = normalize(lp.direction);
     const Vec3 helper = std::fabs(light_dir.z) < 0.9f ? Vec3{0, 0, 1} : Vec3{1, 0, 0};
     // A perspective map covers at most ~160°; wider cones (chandelier-like) are unshadowed outside it.
@@ -673,11 +857,10 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
 
   // Per-frame and per-eye uniforms are set on each shader variant the first time it is used for an
   // eye (variants are separate programs, see shaders.cpp).
-  const bool light_on = scene.light_pipe.has_value();
+  const bool light_on = primary != nullptr;
   const bool gas_on = scene.fluid_gas.has_value();
-  float light_half = 0, disc_radius = 0;
+  float disc_radius = 0;
   Vec3 gas_up{0, 0, 1};
-  if (light_on) light_half = scene.light_pipe->cone_half_angle_deg * 3.14159265f / 180.0f;
   if (gas_on) {
     gas_up = normalize(scene.fluid_gas->up);
     const float R = scene.globe_radius_mm;
@@ -690,6 +873,16 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   flip.at(1, 1) = -1.0f;
   const EyeView* eye_view = nullptr;
   GLuint current = 0;
+  auto set_light = [&](GLuint p, const LightPipe& lp, const char* pos, const char* dir, const char* outer, const char* inner,
+                       const char* intensity, const char* range) {
+    const float half = lp.cone_half_angle_deg * 3.14159265f / 180.0f;
+    set(p, pos, lp.tip_mm);
+    set(p, dir, normalize(lp.direction));
+    set(p, outer, std::cos(half));
+    set(p, inner, std::cos(0.7f * half));
+    set(p, intensity, lp.intensity);
+    set(p, range, std::max(lp.range_mm, 1e-3f));
+  };
   auto use_variant = [&](std::uint32_t key) {
     const GLuint p = scene_program(key);
     if (p != current) {
@@ -702,15 +895,10 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     set(p, "u_view_projection", flip * eye_view->view_projection);
     set(p, "u_camera", eye_view->position_mm);
     set(p, "u_light_view_projection", light_vp);
-    if (light_on) {
-      const LightPipe& lp = *scene.light_pipe;
-      set(p, "u_light_position", lp.tip_mm);
-      set(p, "u_light_direction", light_dir);
-      set(p, "u_cos_outer", std::cos(light_half));
-      set(p, "u_cos_inner", std::cos(0.7f * light_half));
-      set(p, "u_light_intensity", lp.intensity);
-      set(p, "u_light_range", std::max(lp.range_mm, 1e-3f));
-    }
+    if (primary) set_light(p, *primary, "u_light_position", "u_light_direction", "u_cos_outer", "u_cos_inner", "u_light_intensity", "u_light_range");
+    if (secondary)
+      set_light(p, *secondary, "u_light2_position", "u_light2_direction", "u_light2_cos_outer", "u_light2_cos_inner",
+                "u_light2_intensity", "u_light2_range");
     set(p, "u_ambient", scene.ambient);
     set(p, "u_globe_radius", scene.globe_radius_mm);
     set(p, "u_haze_density", scene.haze_density_per_mm);
@@ -731,9 +919,12 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   auto draw_scene_item = [&](const DrawItem& d, int material) {
     const bool has_tex = d.mesh && d.mesh->texture;
     const bool has_burns = d.gpu->burn_texture != 0;
-    const std::uint32_t key = static_cast<std::uint32_t>(material) | (light_on ? kLight : 0u) |
-                              (shadows ? kShadows : 0u) | (gas_on ? kGas : 0u) | (has_tex ? kTexture : 0u) |
-                              (has_burns ? kBurns : 0u);
+    const bool unlit = material == static_cast<int>(MaterialKind::Guide) || material == static_cast<int>(MaterialKind::Glow);
+    const std::uint32_t key = unlit ? static_cast<std::uint32_t>(material)
+                                    : static_cast<std::uint32_t>(material) | (light_on ? kLight : 0u) |
+                                          (shadows ? kShadows : 0u) | (secondary ? kLight2 : 0u) | (gas_on ? kGas : 0u) |
+                                          (has_tex ? kTexture : 0u) | (has_burns ? kBurns : 0u) |
+                                          (scene.flat_shading ? kFlat : 0u);
     const GLuint p = use_variant(key);
     set(p, "u_model", d.mesh ? d.mesh->model : Mat4::identity());
     set(p, "u_base_colour", d.look.base_colour);
@@ -765,19 +956,21 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
   };
 
   // Translucent layers back to front, from the midpoint between the eyes (the base is small
-  // against the working distance, so both eyes agree on the order).
+  // against the viewing distance, so both eyes agree on the order).
   const Vec3 mid = (views.eye[0].position_mm + views.eye[1].position_mm) * 0.5f;
   for (DrawItem& d : translucent) {
     const Vec3 c = d.mesh->model.transform_point((d.gpu->bbox_min + d.gpu->bbox_max) * 0.5f);
     d.sort_distance = length(c - mid);
   }
-  // The retina is the back layer of the eye's interior (it lies on the choroid): every other
-  // translucent layer (membranes on it, gel, the detached retina's neighbours) is on its vitreous
-  // side, so it is drawn first whatever its bounding box says (a large cap's centre sits nearer the
-  // camera than a small membrane lying on it).
-  std::stable_sort(translucent.begin(), translucent.end(), [](const DrawItem& a, const DrawItem& b) {
-    const bool ra = a.mesh->material == MaterialKind::Retina, rb = b.mesh->material == MaterialKind::Retina;
-    if (ra != rb) return ra;
+  // The retina is the back layer of the eye's interior (it lies on the choroid) and the guides are
+  // drawn on it: every other translucent layer (membranes on it, gel, the detached retina's
+  // neighbours) is on their vitreous side, so they come first whatever their bounding boxes say (a
+  // large cap's centre sits nearer the camera than a small membrane lying on it).
+  auto layer = [](const DrawItem& d) {
+    return d.mesh->material == MaterialKind::Retina ? 0 : d.mesh->material == MaterialKind::Guide ? 1 : 2;
+  };
+  std::stable_sort(translucent.begin(), translucent.end(), [&](const DrawItem& a, const DrawItem& b) {
+    if (layer(a) != layer(b)) return layer(a) < layer(b);
     return a.sort_distance > b.sort_distance;
   });
 
@@ -794,8 +987,11 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     for (const DrawItem& d : translucent) draw_scene_item(d, static_cast<int>(d.mesh->material));
     if (gas_on && disc.index_count > 0) {
       DrawItem di{nullptr, &disc, {{0.80f, 0.84f, 0.90f}, 0.12f, 1.2f, 80.0f, false}, 0};
-      draw_scene_item(di, 6);
+      draw_scene_item(di, kDiscMaterial);
     }
+    // Light itself last, added to whatever it shines through (order does not matter for a sum).
+    glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ZERO, GL_ONE);
+    for (const DrawItem& d : glows) draw_scene_item(d, static_cast<int>(MaterialKind::Glow));
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
   }
@@ -831,6 +1027,9 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     }
     glEnable(GL_DEPTH_TEST);
   }
+  // Labels over the (focused or not) picture: they are an overlay, never blurred.
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  draw_labels(scene, views);
 
   // ---- 4. read both eyes at once ----
   out.eye_width = s.eye_width;

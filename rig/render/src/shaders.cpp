@@ -2,9 +2,6 @@
 
 namespace vitreo::render::shaders {
 
-// Scene pass. Positions arrive in the mesh's model space (eye frame for tissue), are placed by
-// u_model (rigid instruments), and are also projected into the light pipe's clip space for the
-// spotlight cone and the shadow map lookup.
 // Scene vertex shader. Positions arrive in the mesh's model space (eye frame for tissue), are placed
 // by u_model (rigid instruments), and are also projected into the light pipe's clip space for the
 // shadow map lookup. The haze is computed per vertex (like classic per-vertex fog): it varies
@@ -14,6 +11,7 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in float a_detachment;
+layout(location = 4) in float a_highlight;
 uniform mat4 u_model;
 uniform mat4 u_view_projection;
 uniform mat4 u_light_view_projection;
@@ -28,6 +26,7 @@ out vec3 v_normal;
 out vec2 v_uv;
 out vec4 v_light_clip;
 out float v_detachment;
+out float v_highlight;
 out float v_haze;
 
 // Length of the camera ray inside the globe before it reaches p: that much infusion / vitreous
@@ -46,6 +45,7 @@ float haze_path(vec3 p) {
 
 void main() {
   v_detachment = a_detachment;
+  v_highlight = a_highlight;
   vec4 world = u_model * vec4(a_position, 1.0);
   v_position = world.xyz;
   v_normal = mat3(u_model) * a_normal;  // rigid placements only: no inverse-transpose needed
@@ -59,19 +59,22 @@ void main() {
 )";
 
 // Scene fragment shader body. It is compiled into variants, one per combination of the defines
-// below (prepended by the renderer), instead of branching on uniforms: llvmpipe executes both sides
-// of a uniform branch under a mask, so an "uber-shader" paid for every feature on every fragment
-// (measured: 3–4× the per-fragment cost of a plain Blinn-Phong shader). On GPUs variants also help.
-//   MATERIAL  MaterialKind order (0 retina … 5 instrument), 6 = the fluid–gas interface disc
-//   LIGHT     the light pipe is present          SHADOWS  a shadow map is bound
+// below (prepended by scene_fragment_source()), instead of branching on uniforms: llvmpipe executes
+// both sides of a uniform branch under a mask, so an "uber-shader" paid for every feature on every
+// fragment (measured: 3–4× the per-fragment cost of a plain Blinn-Phong shader). GPUs like it too.
+//   MATERIAL  MaterialKind order (0 retina, 1 choroid, 2 static, 3 membrane, 4 gel, 5 instrument,
+//             6 guide, 7 glow), 8 = the fluid–gas interface disc
+//   LIGHT     a primary light (light pipe, else chandelier)     SHADOWS  its shadow map is bound
+//   LIGHT2    a second, unshadowed light (the chandelier beside a light pipe)
 //   GAS       a fluid–gas level exists           TEXTURE  the mesh has a texture
-//   BURNS     the mesh has a burn texture
+//   BURNS     the mesh has a burn texture        FLAT     one normal per triangle (F2)
 const char* const kSceneFragmentBody = R"(
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_light_clip;
 in float v_detachment;
+in float v_highlight;
 in float v_haze;
 out vec4 o_colour;
 
@@ -92,6 +95,12 @@ uniform float u_cos_inner;
 uniform float u_light_intensity;
 uniform float u_light_range;
 uniform sampler2DShadow u_shadow_map;
+uniform vec3 u_light2_position;
+uniform vec3 u_light2_direction;
+uniform float u_light2_cos_outer;
+uniform float u_light2_cos_inner;
+uniform float u_light2_intensity;
+uniform float u_light2_range;
 
 uniform vec3 u_camera;
 uniform float u_ambient;
@@ -99,8 +108,10 @@ uniform vec3 u_gas_up;
 uniform float u_gas_level;
 uniform float u_disc_radius;
 
-const vec3 kBurnColour = vec3(0.93, 0.91, 0.83);  // coagulated retina: whitish-yellow
+const vec3 kBurnColour = vec3(0.90, 0.89, 0.84);   // coagulated retina: grey-white
 const vec3 kHazeColour = vec3(0.55, 0.52, 0.48);
+const vec3 kRimColour = vec3(0.94, 0.93, 0.90);    // a rolled cut edge or tear: the retina seen edge-on
+const vec3 kGuideDone = vec3(0.30, 0.60, 1.00);    // the part of a guide already cut or lasered
 
 #if LIGHT && SHADOWS
 // 0 = in shadow, 1 = lit. One depth-compare tap with linear filtering: the texture unit compares
@@ -114,11 +125,58 @@ float shadow_factor() {
 }
 #endif
 
+// A spotlight: radiance reaching v_position and the unit direction toward the light.
+float spot(vec3 position, vec3 direction, float cos_outer, float cos_inner, float intensity, float range, out vec3 l) {
+  vec3 to_light = position - v_position;
+  float d = length(to_light);
+  l = to_light / max(d, 1e-4);
+  float cone = smoothstep(cos_outer, cos_inner, dot(-l, direction));
+  return intensity * cone / (1.0 + (d / range) * (d / range));
+}
+
+// What a light of `radiance` arriving from direction l adds at this fragment: diffuse (with light
+// through the sheet from behind and light scattered whatever the facing) and a Blinn-Phong highlight.
+vec3 shade(float radiance, vec3 l, vec3 n, vec3 v, vec3 albedo, float specular, vec3 spec_colour, float translucency, float scatter) {
+  float nl = dot(n, l);
+  float diffuse = max(nl, 0.0) + translucency * max(-nl, 0.0) + scatter * (1.0 - abs(nl));
+#if MATERIAL == 4
+  diffuse = 0.35 * scatter;  // gel: volume scattering, no surface facing
+#endif
+  vec3 h = normalize(l + v);
+  float spec = specular * pow(max(dot(n, h), 0.0), u_shininess) * (nl > 0.0 ? 1.0 : 0.0);
+  return radiance * (albedo * diffuse * 1.6 + spec_colour * spec);
+}
+
+// Cheap value noise on a lattice (membrane fibres, retina sheen): a hash per corner, smoothed.
+float hash2(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
+float value_noise(vec2 p) {
+  vec2 i = floor(p), f = fract(p);
+  f = f * f * (3.0 - 2.0 * f);
+  return mix(mix(hash2(i), hash2(i + vec2(1, 0)), f.x), mix(hash2(i + vec2(0, 1)), hash2(i + vec2(1, 1)), f.x), f.y);
+}
+
 void main() {
+#if MATERIAL == 6
+  // A guide drawn on the fundus: pending parts in the guide's colour, done parts blue; unlit, so the
+  // task stays visible outside the light pipe's spot.
+  o_colour = vec4(mix(u_base_colour, kGuideDone, clamp(v_highlight, 0.0, 1.0)), u_opacity);
+  return;
+#elif MATERIAL == 7
+  // Light itself (aiming spot and beam, the light pipe's tip and cone): added to what is behind it,
+  // brightest where seen through the most of it (face-on), fading to nothing at silhouettes, so a
+  // beam or a cone of light has no hard outline.
+  float through = abs(dot(normalize(v_normal), normalize(u_camera - v_position)));
+  o_colour = vec4(u_base_colour * (u_opacity * clamp(v_highlight, 0.0, 4.0) * through), 1.0);
+  return;
+#else
   vec3 v = normalize(u_camera - v_position);
+#if FLAT
+  vec3 n = normalize(cross(dFdx(v_position), dFdy(v_position)));
+#else
+  vec3 n = normalize(v_normal);
+#endif
   // Two-sided: tissue is seen from inside and out, so the normal is turned toward the viewer
   // (not chosen by winding, which the supplied meshes need not keep consistent).
-  vec3 n = normalize(v_normal);
   if (dot(n, v) < 0.0) n = -n;
 #if GAS
   bool in_gas = dot(v_position, u_gas_up) > u_gas_level;
@@ -127,22 +185,51 @@ void main() {
   vec3 albedo = u_base_colour;
   float alpha = u_opacity;
   float specular = u_specular;
+  float translucency = 0.0;  // light through the sheet from behind (membranes, detached retina)
+  float scatter = 0.0;       // light scattered by the tissue whatever its facing (gel)
 #if MATERIAL == 0
-  // Retina: a thin, nearly transparent sheet carrying the vessels (the texture's alpha) over the
-  // separate choroid; detached retina is greyish and more opaque, and its vessels move with it.
+  // Retina: a thin, nearly transparent sheet carrying the vessels (premultiplied texture) over the
+  // separate choroid; detached retina is greyer and more opaque (it hides the choroid, and the
+  // subretinal fluid under it tints what little shows through), its vessels move with it; a cut
+  // edge or tear rolls and shows whiter.
 #if TEXTURE
   vec4 vessels = texture(u_texture, v_uv);
 #else
   vec4 vessels = vec4(0.0);
 #endif
   float detached = u_detached ? 1.0 : clamp(v_detachment, 0.0, 1.0);
+  float rim = clamp(v_highlight, 0.0, 1.0);
   vec3 tissue = mix(u_base_colour, u_detached_colour, detached);
   float tissue_alpha = mix(u_opacity, u_detached_opacity, detached);
-  albedo = mix(tissue, vessels.rgb, vessels.a);
-  alpha = max(tissue_alpha, vessels.a * mix(0.95, 0.8, detached));
+  tissue = mix(tissue, kRimColour, 0.8 * rim);
+  tissue_alpha = mix(tissue_alpha, 0.85, rim);
+  float k = mix(0.95, 0.8, detached) * (1.0 - 0.7 * rim);  // vessel opacity
+  float va = vessels.a * k;
+  alpha = va + tissue_alpha * (1.0 - va);
+  albedo = (vessels.rgb * k + tissue * tissue_alpha * (1.0 - va)) / max(alpha, 1e-4);
+  translucency = 0.35 * detached;
+  specular *= 1.0 + 1.5 * rim;
+#elif MATERIAL == 3
+  // Membranes: white-grey fibrous sheets that glisten; thin enough to glow when lit from behind.
+  // (uv: fundus coordinates, 1 ≈ 66 mm: fibres ~0.3 mm apart, wrinkles ~1.5 mm.)
+  float fibres = value_noise(v_uv * vec2(220.0, 60.0)) * 0.6 + value_noise(v_uv * 45.0) * 0.4;
+  albedo *= 0.84 + 0.24 * fibres;
+  translucency = 0.55;
+  scatter = 0.3;  // thick, fibrous tissue scatters light into the view whatever its facing
+#elif MATERIAL == 4
+  // Vitreous gel: a faint haze the same from every side (the shells stand for a volume, so their
+  // coarse outlines must not show), glowing where the light cone crosses it; stained gel carries
+  // white crystals (the texture's alpha).
+  alpha *= smoothstep(1.5, 5.0, length(u_camera - v_position));  // no sheet across the lens of the eye
+  scatter = 1.0;  // volume scattering: the faint glow of the light cone in the gel, whatever the facing
+#if TEXTURE
+  vec4 stain = texture(u_texture, v_uv);  // premultiplied
+  albedo = albedo * (1.0 - stain.a) + stain.rgb;
+  alpha = max(alpha, stain.a * 0.9);
+#endif
 #elif TEXTURE
-  vec4 t = texture(u_texture, v_uv);
-  albedo *= t.rgb;
+  vec4 t = texture(u_texture, v_uv);  // premultiplied (textures are uploaded so, for clean mipmaps)
+  albedo *= t.rgb / max(t.a, 1e-3);
 #if MATERIAL != 1
   alpha *= t.a;
 #endif
@@ -153,7 +240,7 @@ void main() {
   alpha = max(alpha, b);
   specular *= (1.0 - 0.7 * b);  // coagulated tissue is matte
 #endif
-#if MATERIAL == 6
+#if MATERIAL == 8
   // Fluid–gas interface seen from above: a faint sheet with a bright meniscus where it meets the wall.
   float meniscus = smoothstep(0.80, 0.98, length(v_position - u_gas_up * u_gas_level) / max(u_disc_radius, 1e-3));
   alpha = mix(u_opacity, 0.9, meniscus);
@@ -163,37 +250,51 @@ void main() {
 
   vec3 lit = albedo * u_ambient;
   vec3 haze_light = kHazeColour * u_ambient;
-#if LIGHT
-  vec3 to_light = u_light_position - v_position;
-  float d = length(to_light);
-  vec3 l = to_light / d;
-  float cone = smoothstep(u_cos_outer, u_cos_inner, dot(-l, u_light_direction));
-  float falloff = 1.0 / (1.0 + (d / u_light_range) * (d / u_light_range));
-  float radiance = u_light_intensity * cone * falloff;
-#if SHADOWS
-  radiance *= shadow_factor();
-#endif
-  float diffuse = max(dot(n, l), 0.0);
-  vec3 h = normalize(l + v);
-  float spec = specular * pow(max(dot(n, h), 0.0), u_shininess) * (diffuse > 0.0 ? 1.0 : 0.0);
 #if MATERIAL == 5
   vec3 spec_colour = mix(vec3(1.0), albedo, 0.4);  // metal tints its highlight
 #else
   vec3 spec_colour = vec3(1.0);
 #endif
-  lit += radiance * (albedo * diffuse * 1.6 + spec_colour * spec);
-  haze_light += kHazeColour * 0.12 * u_light_intensity;  // light scattered by the whole lit cavity
+#if LIGHT
+  {
+    vec3 l;
+    float radiance = spot(u_light_position, u_light_direction, u_cos_outer, u_cos_inner, u_light_intensity, u_light_range, l);
+#if SHADOWS
+    // Shadowed tissue still gets the light the lit fundus scatters back into the cavity.
+    radiance *= mix(0.22, 1.0, shadow_factor());
+#endif
+    lit += shade(radiance, l, n, v, albedo, specular, spec_colour, translucency, scatter);
+    haze_light += kHazeColour * 0.12 * u_light_intensity;  // light scattered by the whole lit cavity
+  }
   // Light bounced off the lit fundus: metal reflects it (instruments are not black silhouettes),
-  // and the meniscus of the gas bubble shines with it.
+  // membranes and gel scatter it, and the meniscus of the gas bubble shines with it.
 #if MATERIAL == 5
-  lit += albedo * 0.3 * u_light_intensity * (0.4 + 0.6 * max(-n.z, 0.0));
-#elif MATERIAL == 6
+  lit += albedo * 0.5 * u_light_intensity * (0.5 + 0.5 * max(dot(n, normalize(v_position)), 0.0));  // from the wall
+#elif MATERIAL == 3 || MATERIAL == 4
+  lit += albedo * 0.12 * u_light_intensity;
+#elif MATERIAL == 8
   lit += vec3(0.9, 0.92, 0.95) * (0.08 + 0.55 * meniscus) * u_light_intensity;
 #endif
 #endif
+#if LIGHT2
+  {
+    vec3 l;
+    float radiance = spot(u_light2_position, u_light2_direction, u_light2_cos_outer, u_light2_cos_inner, u_light2_intensity, u_light2_range, l);
+    lit += shade(radiance, l, n, v, albedo, specular, spec_colour, translucency, scatter);
+    haze_light += kHazeColour * 0.08 * u_light2_intensity;
+  }
+#endif
   o_colour = vec4(mix(lit, haze_light, v_haze), clamp(alpha, 0.0, 1.0));
+#endif
 }
 )";
+
+std::string scene_fragment_source(const FragmentVariant& v) {
+  auto flag = [](const char* name, bool on) { return std::string("#define ") + name + (on ? " 1\n" : " 0\n"); };
+  return "#version 450 core\n#define MATERIAL " + std::to_string(v.material) + "\n" + flag("LIGHT", v.light) +
+         flag("SHADOWS", v.shadows) + flag("LIGHT2", v.light2) + flag("GAS", v.gas) + flag("TEXTURE", v.texture) +
+         flag("BURNS", v.burns) + flag("FLAT", v.flat) + kSceneFragmentBody;
+}
 
 const char* const kShadowVertex = R"(#version 450 core
 layout(location = 0) in vec3 a_position;
@@ -208,7 +309,8 @@ void main() {}
 
 // Depth of field of the microscope (focus pedal): a full-screen pass per eye that reads the sharp
 // image from a mipmapped texture at a level chosen by the circle of confusion of a thin lens
-// focused at u_focus: coc_px = u_coc_scale·|1/z − 1/focus| (z = depth along the view axis).
+// focused at u_focus: coc_px = u_coc_scale·|1/z − 1/focus| (z = depth along the view axis: a lens
+// focuses on a plane normal to its axis).
 // Mip levels stand in for a blur kernel — cheap on llvmpipe, blockier than a real bokeh.
 const char* const kCompositeVertex = R"(#version 450 core
 void main() {
@@ -242,7 +344,9 @@ void main() {
 
 // Paints one laser burn into a mesh's burn texture (R8, in the mesh's uv space). The quad covers the
 // burn's footprint in uv; u_metric is the surface metric JᵀJ of the hit triangle (J = d position /
-// d uv), so the burn is a circle of radius_mm on the tissue whatever the uv stretch.
+// d uv), so the burn is a circle of radius_mm on the tissue whatever the uv stretch. u_whiteness
+// (0..1) is how far the coagulation has whitened; the texture is blended with MAX, so a burn that
+// whitens over several frames is simply painted again brighter.
 const char* const kBurnVertex = R"(#version 450 core
 layout(location = 0) in vec2 a_corner;  // in [-1, 1]²
 uniform vec2 u_centre_uv;
@@ -259,13 +363,41 @@ in vec2 v_uv;
 uniform vec2 u_centre_uv;
 uniform mat2 u_metric;
 uniform float u_radius_mm;
+uniform float u_whiteness;
 out vec4 o_burn;
 void main() {
   vec2 d = v_uv - u_centre_uv;
   float dist_mm = sqrt(max(dot(d, u_metric * d), 0.0));
   float t = dist_mm / u_radius_mm;
-  float b = 1.0 - smoothstep(0.6, 1.0, t);  // whitish core, soft edge
+  float b = (1.0 - smoothstep(0.6, 1.0, t)) * u_whiteness;  // whitish core, soft edge
   o_burn = vec4(b, 0.0, 0.0, 1.0);
+}
+)";
+
+// Labels: screen-space quads (pixels of one eye, rows from the top) textured from the glyph atlas.
+const char* const kTextVertex = R"(#version 450 core
+layout(location = 0) in vec2 a_pixel;
+layout(location = 1) in vec2 a_uv;
+layout(location = 2) in vec4 a_colour;
+uniform vec2 u_eye_size;
+out vec2 v_uv;
+out vec4 v_colour;
+void main() {
+  v_uv = a_uv;
+  v_colour = a_colour;
+  // Rows are stored top to bottom and read back as they are: image row y is GL window row y.
+  gl_Position = vec4(a_pixel.x / u_eye_size.x * 2.0 - 1.0, a_pixel.y / u_eye_size.y * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* const kTextFragment = R"(#version 450 core
+in vec2 v_uv;
+in vec4 v_colour;
+uniform sampler2D u_atlas;
+out vec4 o_colour;
+void main() {
+  float ink = v_uv.x < 0.0 ? 1.0 : texture(u_atlas, v_uv).a;  // u < 0: a solid quad (markers, shadows)
+  o_colour = vec4(v_colour.rgb, v_colour.a * ink);
 }
 )";
 

@@ -1,7 +1,7 @@
 // Collision cost per 1 ms step: two instruments moving against a deforming ~20k-triangle retina
 // (build_retina_cap, with its detachment) plus an epiretinal membrane. Reports percentiles of:
 //  - collision_us: the instruments' pre-step (eye rotation, shapes, FCL broad phase over the tissue
-//    patches, patch refits, contact candidates, waking) — phase 0→1 of InstrumentSystem::step;
+//    patches, patch refits, contact candidates, waking) — phase 0→1 of Simulation::step;
 //  - tissue_us: the tissue step with the contacts resolved in its substeps (phase 1→2);
 //  - reference_tissue_us: the same scene stepped with no instruments, so tissue_us − reference is
 //    the in-substep contact cost (plus the extra tissue the instruments keep awake);
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/anatomy/retina_cap.hpp"
-#include "core/instruments/instrument_system.hpp"
+#include "core/sim/simulation.hpp"
 
 using namespace vitreo::core;
 
@@ -70,7 +70,7 @@ void BM_TwoInstrumentsVsRetinaAndMembrane(benchmark::State& state) {
     InstrumentSceneOptions o;
     o.ports_mm = {Vec3(-9.0, 4.0, 7.0).normalized() * 11.8, Vec3(9.0, 4.0, 7.0).normalized() * 11.8};
     o.retina_surface = scene.retina;
-    InstrumentSystem sys(scene.world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}, {InstrumentKind::kVitrector, Gauge::k23, 1, {}}});
+    Simulation sys(scene.world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}, {InstrumentKind::kVitrector, Gauge::k23, 1, {}}});
     Probe pr;
     sys.set_phase_probe(probe, &pr);
     std::vector<double> collision, tissue, candidates, refits;

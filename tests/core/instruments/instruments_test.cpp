@@ -3,11 +3,13 @@
 
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include "core/anatomy/retina_cap.hpp"
-#include "core/instruments/instrument_system.hpp"
+#include "core/sim/simulation.hpp"
 #include "core/instruments/topology_adapter.hpp"
 #include "test_meshes.hpp"
+#include "../topology/mesh_topology.hpp"
 
 using namespace vitreo::core;
 
@@ -94,7 +96,7 @@ TEST(Instruments, ForcepsLiftAMembraneAtTheGraspedPoint) {
   anchor_border(world.surface(m), 6.0);
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
   // Off the mesh's vertices on purpose: the grasp is at the point between the jaws, not a vertex.
   const Vec3 offset(0.07, -0.04, 0.0);
   auto at = [&](double z, double act) {
@@ -150,7 +152,7 @@ TEST_P(NoPassThrough, TheShaftNeverEndsBeyondTheTissueWithoutATear) {
   const Vec3 port = Vec3::Zero() - 10.0 * dir;
   InstrumentSceneOptions o;
   o.ports_mm = {port};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k25, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k25, 0, {}}});
   const double start = 9.0, end = 12.5;  // insertion: 1 mm before the membrane to 2.5 mm past it
   const int steps = static_cast<int>((end - start) / (speed * kDt));
   std::size_t tears = 0;
@@ -206,17 +208,17 @@ TEST(Instruments, VitrectorSuctionActsOnlyInsideItsHemisphere) {
   const std::uint32_t s = world.add_surface(d);
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
   InstrumentInput in = down_to(0.0);
   in.pedal = 1.0;
   ASSERT_TRUE(sys.set_input(0, in));
   sys.step(kDt);
   const auto& st = sys.instrument(0);
   const Vec3 apex = st.tip.port_center, axis = st.tip.port_normal;
-  const double radius = o.vitrector_field_mm;
+  const double radius = o.vitrector.field_radius_mm;
   ASSERT_EQ(sys.removal_requests().size(), 1u);
   EXPECT_NEAR(sys.removal_requests()[0].suction_radius_mm, radius, 1e-12);
-  EXPECT_GT(sys.removal_requests()[0].cut_rate_hz, 0.0);
+  EXPECT_GT(sys.removal_requests()[0].cut_rate_cpm, 0.0);
   std::vector<Vec3> start(world.surface(s).vertex_slots());
   const Surface& surf = world.surface(s);
   for (std::uint32_t v = 0; v < surf.vertex_slots(); ++v) start[v] = d.mesh.positions[v];
@@ -251,7 +253,7 @@ TEST(Instruments, LaserBurnIsCentredOnTheExactRayHit) {
   anchor_border(world.surface(0), 6.0);
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(3, 1, 8)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
   const Vec3 dir = Vec3(-0.37, -0.11, -1.0).normalized();
   InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], dir, 5.0);
   ASSERT_TRUE(sys.set_input(0, in));
@@ -277,7 +279,7 @@ TEST(Instruments, LaserAdheresAttachedRetinaOnlyAndBurnSizeFollowsEnergy) {
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 10.4, 6.0)};
   o.retina_surface = scene.retina;
-  InstrumentSystem sys(scene.world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+  Simulation sys(scene.world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
   const double R = scene.world.surface(scene.retina).position(0).norm();
   auto fire = [&](const Vec3& target, double power, double duration, bool on_sphere) {
     const Vec3 dir = (target - o.ports_mm[0]).normalized();
@@ -320,7 +322,7 @@ TEST(Instruments, FluidLevelFollowsTheAspiratingNeedleUnderAirInfusion) {
   world.add_surface(sheet(2.0, 4, -11.0));
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k20, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k20, 0, {}}});
   InstrumentInput in = down_to(2.0);
   in.pedal = 1.0;
   // No air infusion: the chamber stays full of fluid.
@@ -369,7 +371,7 @@ TEST(Instruments, SubretinalFluidDrainsThroughABreakOnlyUnderGas) {
     o.ports_mm = {Vec3(0, 10.4, 6.0)};
     o.retina_surface = scene.retina;
     o.drainage_sites = {{scene.detachment_force, brk, 1.5}};
-    InstrumentSystem sys(scene.world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k20, 0, {}}});
+    Simulation sys(scene.world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k20, 0, {}}});
     if (gas) {
       Environment env = scene.world.environment();
       env.fluid_level_z_mm = brk.z() - 2.0;  // exchange done down to below the break
@@ -418,7 +420,7 @@ TEST_P(PeelAttachment, WeakLetsGoStrongHolds) {
   }
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
   for (int i = 0; i <= 20; ++i) {
     ASSERT_TRUE(sys.set_input(0, down_to(0.05, i / 20.0)));
     sys.step(kDt);
@@ -454,7 +456,7 @@ TEST(Instruments, ShaftOffItsPortRotatesTheEye) {
   InstrumentSceneOptions o;
   const Vec3 port(0, 0, 11.5);
   o.ports_mm = {port};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}});
   // The shaft's line passes 0.3 mm beside the port (+x): the sclera is dragged toward it.
   InstrumentInput in = InstrumentInput::through_port(port + Vec3(0.3, 0, 0), -Vec3::UnitZ(), 8.0);
   ASSERT_TRUE(sys.set_input(0, in));
@@ -482,7 +484,7 @@ TEST(Instruments, CollisionsBetweenInstrumentsLensAndWallAreReported) {
   o.anatomy.has_lens = true;
   o.anatomy.lens_center_mm = Vec3(0, 0, 8.5);
   o.anatomy.lens_semi_axes_mm = Vec3(4.5, 4.5, 2.0);
-  InstrumentSystem sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}, {InstrumentKind::kVitrector, Gauge::k23, 1, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}, {InstrumentKind::kVitrector, Gauge::k23, 1, {}}});
   // Both tips meet at (0, 0, 0).
   auto toward = [&](int port, const Vec3& target, double extra) {
     const Vec3 dir = (target - o.ports_mm[port]).normalized();
@@ -511,7 +513,7 @@ TEST(Instruments, LightPipeNearTheMaculaAccumulatesDose) {
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 8, 8)};
   o.macula_mm = Vec3(0, 0, -12);
-  InstrumentSystem sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kLightPipe, Gauge::k23, 0, {}}});
   const Vec3 dir = (*o.macula_mm - o.ports_mm[0]).normalized();
   const double full = (*o.macula_mm - o.ports_mm[0]).norm();
   InstrumentInput far = InstrumentInput::through_port(o.ports_mm[0], dir, full - 10.0);
@@ -535,7 +537,7 @@ TEST(Instruments, BladesAndScissorsReportTheirSweptEdges) {
   world.add_surface(sheet(2.0, 4, -11.0));
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10), Vec3(3, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}, {InstrumentKind::kScissors, Gauge::k23, 1, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}, {InstrumentKind::kScissors, Gauge::k23, 1, {}}});
   InstrumentInput blade = down_to(2.0);
   InstrumentInput sc = InstrumentInput::through_port(o.ports_mm[1], -Vec3::UnitZ(), 8.0);
   ASSERT_TRUE(sys.set_input(0, blade));
@@ -566,7 +568,7 @@ TEST(Instruments, ExcessiveForceOnTheRetinaIsReported) {
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 11.5)};
   o.retina_surface = scene.retina;
-  InstrumentSystem sys(scene.world, o, {{InstrumentKind::kLightPipe, Gauge::k20, 0, {}}});
+  Simulation sys(scene.world, o, {{InstrumentKind::kLightPipe, Gauge::k20, 0, {}}});
   std::size_t events = 0;
   double peak = 0.0;
   for (int i = 0; i <= 400; ++i) {  // down onto the posterior pole and 0.5 mm into it at 10 mm/s
@@ -603,7 +605,7 @@ TEST(Instruments, PickLiftsOneEdgeWithoutTakingTheOther) {
   o.ports_mm = {Vec3(0.1, 0, 10)};
   InstrumentDescription pick{InstrumentKind::kPick, Gauge::k25, 0, {}};
   pick.dimensions.pick_length_mm = 0.6;
-  InstrumentSystem sys(world, o, {pick});
+  Simulation sys(world, o, {pick});
   auto at = [&](double z, double twist = 0.0) {
     return InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z, twist);
   };
@@ -643,7 +645,7 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
   TopologyAdapter topology(world, {m}, {});
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
   sys.set_topology(&topology);
   const std::uint32_t before = world.surface(m).vertex_slots();
   auto at = [&](double x, double z) {
@@ -661,8 +663,15 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
     ASSERT_TRUE(sys.set_input(0, at(-1.0 + 2.0 * i / 200.0, -0.4)));
     ASSERT_TRUE(sys.step(kDt).tissue.ok);
   }
+  // Out of the eye: the incision ends where the blade was (until then its last piece is the
+  // crack's, not yet cut).
+  InstrumentInput out = at(1.0, -0.4);
+  out.present = false;
+  ASSERT_TRUE(sys.set_input(0, out));
+  ASSERT_TRUE(sys.step(kDt).tissue.ok);
   EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
-  EXPECT_GT(topology.springs_opened(), 10u);
+  // y = 0 is a row of springs of this mesh: the cut opens the ten between x = −1 and 1.
+  EXPECT_GE(topology.springs_opened(), 10u);
   const Surface& s = world.surface(m);
   ASSERT_GT(s.vertex_slots(), before);
   // Every vertex the cut made lies on the blade's path (x from −1 to 1 along y = 0).
@@ -671,6 +680,107 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
     EXPECT_LT(std::abs(s.rest_position(v).y()), 0.05) << v;
     EXPECT_GT(s.rest_position(v).x(), -1.1);
     EXPECT_LT(s.rest_position(v).x(), 1.1);
+  }
+}
+
+// A tracked blade at 5 mm/s moves 5 µm per 1 ms step: the incision the adapter keeps for it cuts
+// one slit along the whole path (before incisions, each step's sweep was cut on its own and such
+// steps left separate slits or none), and the blade leaving the eye ends it where it last was.
+TEST(Instruments, ABladeAt5mmPerSecondCutsOneSlitAndLeavingTheEyeEndsIt) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
+  anchor_border(world.surface(m), 4.0);
+  TopologyAdapter topology(world, {m}, {});
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
+  sys.set_topology(&topology);
+  auto at = [&](double x, double z) {
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z);
+    in.tip_fixture_mm.x() += x;
+    return in;
+  };
+  // Plunge through the membrane at x = −0.9, then 1.6 mm along +x at 5 mm/s, then out of the eye.
+  for (int i = 0; i <= 50; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-0.9, 0.6 - 1.0 * i / 50.0)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  for (int i = 1; i <= 320; ++i) {
+    ASSERT_TRUE(sys.set_input(0, at(-0.9 + 0.005 * i, -0.4)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  InstrumentInput out = at(0.7, -0.4);
+  out.present = false;
+  ASSERT_TRUE(sys.set_input(0, out));
+  ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
+  EXPECT_EQ(topology.gaps(), 0u);
+  const Surface& s = world.surface(m);
+  const test::CornerTopology t = test::corner_topology(s);
+  EXPECT_TRUE(t.ok()) << t.describe();
+  EXPECT_EQ(t.components, 1u) << t.describe();
+  EXPECT_EQ(t.boundary_loops, 2u) << "one slit: " << t.describe();
+  // The slit runs from x = −0.9 to 0.7 along y = 0: its ends are there (in the rest shape).
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+    if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
+    for (auto v : s.edge_vertices(e)) {
+      const Vec3& p = s.rest_position(v);
+      if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;  // the border
+      EXPECT_LT(std::abs(p.y()), 0.02) << "on the path";
+      lo = std::min(lo, p.x());
+      hi = std::max(hi, p.x());
+    }
+  }
+  EXPECT_NEAR(lo, -0.9, 0.02);
+  EXPECT_NEAR(hi, 0.7, 0.02) << "the cut ends where the blade left";
+}
+
+// Scissors closing on a membrane in small steps of the handle cut between where the open jaws
+// pierced it (before, the instrument handed over a quad along the closing jaws' own line, which
+// swept no area: the rig's scissors never cut).
+TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
+  for (const int steps : {1, 200}) {
+    SCOPED_TRACE(std::to_string(steps) + " steps");
+    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+    const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
+    anchor_border(world.surface(m), 4.0);
+    TopologyAdapter topology(world, {m}, {});
+    InstrumentSceneOptions o;
+    o.ports_mm = {Vec3(0, 0, 10)};
+    InstrumentSystem sys(world, o, {{InstrumentKind::kScissors, Gauge::k23, 0, {}}});
+    sys.set_topology(&topology);
+    // The hinge 0.3 mm above the membrane (the tip is a jaw length below it), jaws open in the
+    // x–z plane: each jaw pierces it 0.3 · tan 25° = 0.14 mm from under the hinge.
+    const double jaw = InstrumentDimensions{}.jaw_length_mm, half = InstrumentDimensions{}.jaw_open_deg * std::numbers::pi / 180.0;
+    auto at = [&](double actuation) { return down_to(0.3 - jaw, actuation); };
+    for (int i = 0; i <= 20; ++i) {
+      ASSERT_TRUE(sys.set_input(0, at(0.0)));
+      ASSERT_TRUE(sys.step(kDt).tissue.ok);
+    }
+    for (int i = 1; i <= steps; ++i) {
+      ASSERT_TRUE(sys.set_input(0, at(static_cast<double>(i) / steps)));
+      ASSERT_TRUE(sys.step(kDt).tissue.ok);
+    }
+    EXPECT_TRUE(topology.last_error().is_ok()) << topology.last_error().message();
+    EXPECT_EQ(topology.gaps(), 0u);
+    const Surface& s = world.surface(m);
+    const test::CornerTopology t = test::corner_topology(s);
+    EXPECT_EQ(t.components, 1u) << t.describe();
+    EXPECT_EQ(t.boundary_loops, 2u) << "one slit between the jaws: " << t.describe();
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+      if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
+      for (auto v : s.edge_vertices(e)) {
+        const Vec3& p = s.rest_position(v);
+        if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;
+        EXPECT_LT(std::abs(p.y()), 0.02);
+        lo = std::min(lo, p.x());
+        hi = std::max(hi, p.x());
+      }
+    }
+    EXPECT_NEAR(lo, -0.3 * std::tan(half), 0.02);
+    EXPECT_NEAR(hi, 0.3 * std::tan(half), 0.02);
   }
 }
 
@@ -685,7 +795,7 @@ TEST(Instruments, VitrectorRemovesOnlyAtItsPort) {
   TopologyAdapter topology(world, {}, {gel});
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(-10, 0, 0.6)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
   sys.set_topology(&topology);
   // Shaft along +x just above the sheet, port turned down toward it.
   InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], Vec3::UnitX(), 10.0, std::numbers::pi);
@@ -705,8 +815,39 @@ TEST(Instruments, VitrectorRemovesOnlyAtItsPort) {
   for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
     const auto tv = s.triangle_vertices(t);
     const Vec3 c = (s.rest_position(tv[0]) + s.rest_position(tv[1]) + s.rest_position(tv[2])) / 3.0;
-    if ((c - port).norm() > o.vitrector_field_mm + 0.5) {
+    if ((c - port).norm() > o.vitrector.field_radius_mm + 0.5) {
       EXPECT_TRUE(s.triangle_alive(t)) << t;
     }
   }
+}
+
+// The step's last stage is its observers: they see the step's final outputs (the tissue stepped,
+// the instruments' events of this step), once per step.
+TEST(Simulation, TheObserverRunsLastOncePerStep) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 100.0), no_pressure(), no_sleep());
+  const auto sm = world.add_surface(sheet(4.0, 16, 0.0));
+  anchor_border(world.surface(sm), 4.0);
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  Simulation sim(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
+  struct Recorder final : StepObserver {
+    const Simulation* sim = nullptr;
+    std::vector<std::uint64_t> world_steps;
+    std::vector<std::size_t> grasps;
+    void after_step(double) override {
+      world_steps.push_back(sim->world().step_count());
+      grasps.push_back(count(sim->events(), InstrumentEventKind::kGrasp));
+    }
+  } recorder;
+  recorder.sim = &sim;
+  sim.set_observer(&recorder);
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_TRUE(sim.set_input(0, down_to(0.05, i < 20 ? 0.0 : 1.0)));
+    sim.step(kDt);
+  }
+  ASSERT_EQ(recorder.world_steps.size(), 30u);
+  for (std::size_t i = 0; i < 30; ++i) EXPECT_EQ(recorder.world_steps[i], world.step_count() - 29 + i) << "after the tissue step";
+  EXPECT_EQ(std::accumulate(recorder.grasps.begin(), recorder.grasps.end(), std::size_t{0}), 1u)
+      << "the grasp reached the observer in the step it happened";
+  EXPECT_EQ(recorder.grasps[20], 1u);
 }

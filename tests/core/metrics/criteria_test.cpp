@@ -205,7 +205,7 @@ TEST(Criteria, LaserCoverageCountsTheRingUnderAdheredBurns) {
   InstrumentSceneOptions o;
   o.ports_mm = {port->inner_mm};
   o.retina_surface = scene.retina;
-  InstrumentSystem sys(scene.world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+  Simulation sys(scene.world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
   sys.set_eye_fixture_rotation(Quat::Identity());
   SessionMetrics m(scene, &sys);
   const Guide& ring = scene.guides[1];

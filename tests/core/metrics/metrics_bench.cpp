@@ -1,6 +1,6 @@
 // Cost of the session metrics on a built case with every criterion kind but gel_removed (retina of N
 // vertices, membrane, detachment, cut path and laser ring):
-//  - BM_Observe/N: SessionMetrics::observe() after each 1 ms InstrumentSystem step (the step itself is
+//  - BM_Observe/N: SessionMetrics::observe() after each 1 ms Simulation step (the step itself is
 //    not timed), two instruments moving, one pressing the retina — per-step cost, p50/p99 in µs;
 //  - BM_CriteriaAndScore/N: criteria() + score() after half the cut path has been cut and 16 laser
 //    spots placed (the scans a telemetry-rate score update does), p50/p99 in µs.
@@ -59,7 +59,7 @@ SceneDescription bench_case(int vertices) {
 
 struct Bench {
   Scene scene;
-  std::unique_ptr<InstrumentSystem> sys;
+  std::unique_ptr<Simulation> sys;
   std::unique_ptr<SessionMetrics> metrics;
   Vec3 port[2];
   explicit Bench(int vertices) : scene(build_scene(bench_case(vertices), {false, false})) {
@@ -70,7 +70,7 @@ struct Bench {
     }
     o.ports_mm = {port[0], port[1]};
     o.retina_surface = scene.retina;
-    sys = std::make_unique<InstrumentSystem>(
+    sys = std::make_unique<Simulation>(
         scene.world, o, std::vector<InstrumentDescription>{{InstrumentKind::kLightPipe, Gauge::k23, 1, {}}, {InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
     metrics = std::make_unique<SessionMetrics>(scene, sys.get());
   }

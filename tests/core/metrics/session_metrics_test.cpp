@@ -32,7 +32,7 @@ SurfaceDescription sheet(double size, int cells, double z) {
 struct Bench {
   TissueWorld world;
   std::uint32_t retina = 0;
-  std::unique_ptr<InstrumentSystem> instruments;
+  std::unique_ptr<Simulation> instruments;
 
   explicit Bench(InstrumentKind kind = InstrumentKind::kDrainageNeedle, double sheet_z = 0.0)
       : world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()) {
@@ -47,7 +47,7 @@ struct Bench {
     InstrumentSceneOptions o;
     o.ports_mm = {kPort};
     o.retina_surface = retina;
-    instruments = std::make_unique<InstrumentSystem>(world, o, std::vector<InstrumentDescription>{{kind, Gauge::k23, 0, {}}});
+    instruments = std::make_unique<Simulation>(world, o, std::vector<InstrumentDescription>{{kind, Gauge::k23, 0, {}}});
     // The rig's measured eye rotation: none, so the eye frame is the fixture frame exactly.
     instruments->set_eye_fixture_rotation(Quat::Identity());
   }

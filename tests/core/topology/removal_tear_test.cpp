@@ -50,7 +50,9 @@ TEST(Vitrector, RemovesWhatEntersTheRemovalHemisphereClippedAtItsBoundary) {
   }
 }
 
-TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
+// Suction is the solver's (a SuctionField, as the instruments hand it over); the vitrector cuts what
+// it draws into the port, at the cut rate.
+TEST(Vitrector, CutsOnlyAtTheCutRateWhatTheSuctionDrawsIn) {
   SurfaceDescription d = sheet(kSheetW, kSheetH, kSheetCols, kSheetRows);
   Environment env;
   env.apply_pressure = false;
@@ -68,7 +70,7 @@ TEST(Vitrector, CutsOnlyAtTheCutRateAndAttractsTowardThePort) {
   Vitrector vit(s, vs);
   const Vec3 port(2.0, 1.5, 0.3);
   ASSERT_TRUE(vit.set_pose(port, Vec3(0, 0, -1)));
-  ASSERT_TRUE(vit.set_vacuum(400.0));
+  ASSERT_TRUE(world.set_suction_fields(std::vector<SuctionField>{{port, Vec3(0, 0, -1), vs.field_radius_mm, 0.8 * vs.suction_pa}}));
   ASSERT_TRUE(vit.set_cut_rate(0.0));
   const double mass0 = s.total_mass();
   // Suction only: tissue under the port rises toward it, nothing is removed.
@@ -116,12 +118,11 @@ TEST(Vitrector, InvalidRequestsAreRefused) {
   EXPECT_FALSE(vit.apply(1e-3).status) << "no pose yet";
   EXPECT_FALSE(vit.set_pose(Vec3(std::nan(""), 0, 0), Vec3::UnitZ()));
   EXPECT_FALSE(vit.set_pose(Vec3::Zero(), Vec3::Zero()));
-  EXPECT_FALSE(vit.set_vacuum(-1.0));
-  EXPECT_FALSE(vit.set_vacuum(1e4));
+  EXPECT_FALSE(vit.set_cut_rate(-1.0));
+  EXPECT_FALSE(vit.set_cut_rate(1e6));
   EXPECT_FALSE(vit.set_cut_rate(std::nan("")));
   ASSERT_TRUE(vit.set_pose(Vec3(1, 1, 1), Vec3(0, 0, -1)));
-  // Refused requests change nothing: no pose, vacuum or cut rate is taken, the sheet is untouched.
-  ASSERT_TRUE(vit.set_vacuum(300.0));
+  // Refused requests change nothing: no pose or cut rate is taken, the sheet is untouched.
   ASSERT_TRUE(vit.set_cut_rate(6000.0));
   const auto version = s.topology_version();
   const double mass = s.total_mass();

@@ -139,7 +139,6 @@ void BM_VitrectorStep(benchmark::State& state) {
   TissueWorld& world = scene.world;
   Surface& s = world.surface(scene.retina);
   Vitrector vit(s);
-  (void)vit.set_vacuum(400.0);
   (void)vit.set_cut_rate(5000.0);
   std::vector<double> us;
   double phi = 0.0, removed = 0.0;

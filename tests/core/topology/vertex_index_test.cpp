@@ -7,7 +7,6 @@
 #include <random>
 #include <vector>
 
-#include "core/scene/world_access.hpp"
 #include "core/tissue/tissue_world.hpp"
 #include "core/topology/cut.hpp"
 #include "core/topology/vertex_index.hpp"
@@ -82,7 +81,7 @@ TEST(VertexIndex, ReportsExactlyTheVerticesInTheBoxWhileTheTissueMovesSleepsAndC
   std::uint32_t min_refits = 1u << 30, max_refits = 0;
   for (int step = 0; step < 400; ++step) {
     ASSERT_TRUE(world.step(1e-3).ok);
-    if (step == 50) WorldAccess::write_state(world, saved);
+    if (step == 50) world.write_state(saved);
     if (step % 40 == 7) {  // a hand-placed vertex, asleep or not
       const std::uint32_t v = std::uniform_int_distribution<std::uint32_t>(0, s.vertex_slots() - 1)(rng);
       if (s.vertex_alive(v)) {
@@ -105,7 +104,7 @@ TEST(VertexIndex, ReportsExactlyTheVerticesInTheBoxWhileTheTissueMovesSleepsAndC
   EXPECT_LT(min_refits, index.patches_in_use());
   EXPECT_GT(max_refits, 0u);
   // A snapshot restore moves every vertex (sleeping ones too) without waking anything.
-  ASSERT_TRUE(WorldAccess::read_state(world, saved.data(), saved.size()));
+  ASSERT_TRUE(world.read_state(saved.data(), saved.size()));
   expect_exact(index, s, rng, "after a snapshot restore");
 }
 

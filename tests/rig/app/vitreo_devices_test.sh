@@ -19,6 +19,9 @@ check "identify on a missing port fails with a reason" '[ $rc -ne 0 ] && grep -q
 "$B" simulate --device pedals --link "$dir/tty" --duration-s 6 > "$dir/sim.out" 2>&1 & sim=$!
 for _ in $(seq 50); do [ -e "$dir/tty" ] && break; sleep 0.05; done
 check "identify the simulated pedals" '"$B" identify --serial "$dir/tty" 2>/dev/null | grep -q "^pedals serial 2001 .*protocol 1.0"'
+check "identify them by their URI" '"$B" identify --device "serial:$dir/tty" 2>/dev/null | grep -q "^pedals serial 2001 "'
+"$B" identify --device "serial:$dir/tty?speed=1" > /dev/null 2> "$dir/err"; rc=$?
+check "a bad URI is refused with the reason" '[ $rc -ne 0 ] && [ "$(wc -l < "$dir/err")" -eq 1 ] && grep -q "unknown parameter" "$dir/err"'
 "$B" watch --serial "$dir/tty" --duration-s 1.5 --print-hz 5 > "$dir/watch" 2> "$dir/watch.log"
 check "watch shows decoded pedal samples" 'grep -q "^pedal t_dev=" "$dir/watch"'
 check "watch shows link statistics while streaming" 'grep -q "^\[streaming\] .*delivered=[1-9]" "$dir/watch"'

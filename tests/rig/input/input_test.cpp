@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <iterator>
+
+#include <fstream>
+
 #include <cmath>
 #include <numbers>
 
@@ -122,6 +126,25 @@ TEST(Pedals, MicroscopePedalZoomsFocusesAndStepsTheLight) {
   EXPECT_DOUBLE_EQ(m.controls().zoom, 4.0);
   EXPECT_DOUBLE_EQ(m.controls().focus_offset_mm, -1.5);
   EXPECT_NEAR(m.controls().light_level, 0.8, 1e-12);
+  EXPECT_EQ(m.controls().pan_x, 0.0) << "a pedal without joystick axes leaves the field still";
+  EXPECT_EQ(m.controls().pan_y, 0.0);
+}
+
+TEST(Pedals, MicroscopeJoystickHasADeadBandAndFullDeflection) {
+  rig::PedalMapper m;
+  rig::PedalReading r;
+  r.pedal_id = 1;
+  r.axis_count = 4;
+  r.axes[0] = 0.0;
+  r.axes[1] = 0.5;
+  r.axes[2] = 0.52;  // inside the dead band (0.08 of the half travel)
+  r.axes[3] = 0.0;   // full deflection down
+  ASSERT_TRUE(m.apply(r));
+  EXPECT_EQ(m.controls().pan_x, 0.0);
+  EXPECT_DOUBLE_EQ(m.controls().pan_y, -1.0);
+  r.axes[2] = 0.77;  // half way between the dead band's edge (0.54) and the end
+  ASSERT_TRUE(m.apply(r));
+  EXPECT_NEAR(m.controls().pan_x, 0.5, 1e-12);
 }
 
 TEST(Pedals, ABrokenPedalCannotOpenTheVacuum) {
@@ -148,4 +171,41 @@ TEST(Pedals, MappingConfigurationIsValidatedWithLineNumbers) {
   EXPECT_THROW(rig::parse_pedal_mapping("[pedals]\nvacuum_max_mmhg = 5000\n", "x"), std::runtime_error);
   EXPECT_THROW(rig::parse_pedal_mapping("[pedals]\nvacuum_axis = 0.5\n", "x"), std::runtime_error);
   EXPECT_THROW(rig::parse_pedal_mapping("[pedals\n", "x"), std::runtime_error);
+}
+
+// Issue 20: one switch for both laser and reflux was accepted (every laser shot would reflux too).
+TEST(Pedals, ASwitchOrAxisDoingTwoJobsIsRefusedWithBothNames) {
+  auto refused = [](const std::string& toml, const char* says) {
+    try {
+      rig::parse_pedal_mapping(toml, "rig.toml");
+      ADD_FAILURE() << "accepted: " << toml;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  refused("[pedals]\nlaser_switch = 0\n", "pedals.reflux_switch and pedals.laser_switch are the same switch (0)");
+  refused("[pedals]\nair_switch = 2\n", "pedals.instrument_switch and pedals.air_switch are the same switch (2)");
+  refused("[pedals]\ncut_rate_axis = 0\n", "pedals.vacuum_axis and pedals.cut_rate_axis are the same axis (0)");
+  refused("[pedals]\nlight_down_switch = 0\n", "the same switch");
+  refused("[pedals]\nfocus_axis = 0\n", "the same axis");
+  refused("[pedals]\nmicroscope_pedal_id = 0\n", "the same pedal id");
+  // "none" (-1) may repeat; the shipped rig file is consistent.
+  EXPECT_NO_THROW(rig::parse_pedal_mapping("[pedals]\nreflux_switch = -1\nlaser_switch = -1\n", "rig.toml"));
+  std::ifstream f(std::string(VITREO_SOURCE_DIR) + "/rig/config/default-rig.toml");
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(text.empty());
+  EXPECT_NO_THROW(rig::parse_pedal_mapping(text, "default-rig.toml"));
+}
+
+// toml++ 3.3.0's undefined behaviour (rig/files/toml_guard.hpp) is kept away from pedal files too.
+TEST(Pedals, TextTomlPlusPlusWouldMisbehaveOnIsRefusedWithItsLine) {
+  for (const char* bad : {"[&x]\n", "[pedals]\nfo \xc2\xb5 = 1\n", "[[[a]]]\n"}) {
+    try {
+      rig::parse_pedal_mapping(bad, "rig.toml");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("rig.toml:", 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find("column"), std::string::npos) << e.what();
+    }
+  }
 }

@@ -190,10 +190,11 @@ class BareGlSameShading {
       Item it;
       it.mesh = &m;
       it.look = vr::default_appearance(m.material, m.detached);
-      const int material = static_cast<int>(m.material);
-      const std::string src = std::string("#version 450 core\n#define MATERIAL ") + std::to_string(material) +
-                              "\n#define LIGHT 1\n#define SHADOWS 1\n#define GAS 0\n#define TEXTURE " +
-                              (m.texture ? "1" : "0") + "\n#define BURNS 0\n" + vitreo::render::shaders::kSceneFragmentBody;
+      vitreo::render::shaders::FragmentVariant variant;
+      variant.material = static_cast<int>(m.material);
+      variant.light = variant.shadows = true;
+      variant.texture = m.texture != nullptr;
+      const std::string src = vitreo::render::shaders::scene_fragment_source(variant);
       it.prog = link(vitreo::render::shaders::kSceneVertex, src.c_str());
       glGenVertexArrays(1, &it.vao);
       glBindVertexArray(it.vao);
@@ -210,6 +211,8 @@ class BareGlSameShading {
       glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, st, reinterpret_cast<void*>(offsetof(vr::Vertex, uv)));
       glEnableVertexAttribArray(3);
       glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, st, reinterpret_cast<void*>(offsetof(vr::Vertex, detachment)));
+      glEnableVertexAttribArray(4);
+      glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, st, reinterpret_cast<void*>(offsetof(vr::Vertex, highlight)));
       glGenBuffers(1, &it.ibo);
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, it.ibo);
       glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.geometry->indices.size() * 4),

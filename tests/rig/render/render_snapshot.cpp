@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     FrameScene scene = testing::make_scene(o);
     if (burn) {
       for (auto& m : scene.meshes)
-        if (m.id == testing::kRetina) m.burns.push_back({testing::retina_point(14, 250), {}, 0.4f});
+        if (m.id == testing::kRetina) m.burns.push_back({testing::retina_point(14, 250), {}, 0.4f, {}});
     }
     if (defocus_mm != 0.0f) {
       scene.microscope.depth_of_field = true;

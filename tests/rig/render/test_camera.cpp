@@ -1,6 +1,8 @@
 // The stereo microscope's geometry, checked analytically (no GL needed).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "synthetic_scene.hpp"
 #include "vitreo/render/camera.hpp"
 
@@ -79,4 +81,39 @@ TEST(StereoCamera, WideAngleSeesToTheEquator) {
   EXPECT_GT(p.x, 0.0f);
   EXPECT_LT(p.x, static_cast<float>(kW));
   EXPECT_LT(vr::stereo_views(m, 12.0f, kW, kH).eye[0].position_mm.z, 20.0f);
+}
+
+// Through the eye's optics from the pupil: the field is centred on the target wherever it lies on
+// the fundus, image_up (projected) points up, zoom narrows the field about the target, and without
+// the re-inverter the picture turns 180° with the disparity of every point reversed.
+TEST(StereoCamera, PupilViewLooksAtTheTargetWithItsUpAndZoom) {
+  vr::Microscope m;
+  m.wide_angle = true;
+  m.view_point_mm = vr::Vec3{0, 0, 4};
+  m.wide_field_deg = 40.0f;
+  m.target_mm = vr::testing::retina_point(60.0f, 135.0f);
+  m.image_up = vr::Vec3{0, 0, 1};  // toward the front of the eye
+  const vr::FrameScene s = scene_with(m);
+  const auto c = project_to_pixel(s, 0, m.target_mm, kW, kH), cr = project_to_pixel(s, 1, m.target_mm, kW, kH);
+  EXPECT_NEAR(c.x, kW / 2.0f, 1e-2f);
+  EXPECT_NEAR(c.y, kH / 2.0f, 1e-2f);
+  EXPECT_NEAR(cr.x, kW / 2.0f, 1e-2f) << "both eyes converge on the target";
+  const vr::Vec3 anterior = vr::testing::retina_point(65.0f, 135.0f);  // nearer the ora
+  EXPECT_LT(project_to_pixel(s, 0, anterior, kW, kH).y, c.y - 3) << "the front of the eye is up in the image";
+  const vr::Vec3 off = vr::testing::retina_point(60.0f, 140.0f);
+  const float d1 = std::hypot(project_to_pixel(s, 0, off, kW, kH).x - c.x, project_to_pixel(s, 0, off, kW, kH).y - c.y);
+  m.zoom = 2.5f;
+  const vr::FrameScene z = scene_with(m);
+  const float d2 = std::hypot(project_to_pixel(z, 0, off, kW, kH).x - c.x, project_to_pixel(z, 0, off, kW, kH).y - c.y);
+  EXPECT_NEAR(d2 / d1, 2.5f, 0.05f) << "tan(field/2) / zoom: close to ×zoom for a small offset";
+  m.zoom = 1.0f;
+  m.image_inverted = true;
+  const vr::FrameScene inv = scene_with(m);
+  const vr::Vec3 near_p = m.target_mm * 0.7f;
+  const float d_up = project_to_pixel(s, 0, near_p, kW, kH).x - project_to_pixel(s, 1, near_p, kW, kH).x;
+  const float d_inv = project_to_pixel(inv, 0, near_p, kW, kH).x - project_to_pixel(inv, 1, near_p, kW, kH).x;
+  EXPECT_NEAR(d_inv, -d_up, 1e-3f);
+  const auto pi = project_to_pixel(inv, 0, anterior, kW, kH), pu = project_to_pixel(s, 0, anterior, kW, kH);
+  EXPECT_NEAR(pi.x, kW - pu.x, 1e-2f);
+  EXPECT_NEAR(pi.y, kH - pu.y, 1e-2f);
 }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <memory>
 
+#include "render_fixture.hpp"
 #include "synthetic_scene.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/image_compare.hpp"
@@ -56,19 +57,8 @@ Rgb patch(const vr::Image& img, vr::Vec2 p, int k = 1) {
   return s;
 }
 
-class RenderScenes : public ::testing::Test {
+class RenderScenes : public vt::RendererFixture<kW, kH> {
  protected:
-  void SetUp() override {
-    vr::EglOptions o;
-    o.honour_environment = false;
-    context_ = std::make_unique<vr::EglContext>(o);
-    renderer_ = std::make_unique<vr::StereoRenderer>(vr::RenderSettings{kW, kH, 512, 512});
-  }
-  vr::StereoFrame render(const vr::FrameScene& s) {
-    vr::StereoFrame f;
-    renderer_->render(s, f);
-    return f;
-  }
   static vr::Mesh* mesh(vr::FrameScene& s, std::uint32_t id) {
     for (auto& m : s.meshes)
       if (m.id == id) return &m;
@@ -97,9 +87,6 @@ class RenderScenes : public ::testing::Test {
                     << " (limits rmse<=2.5, over(24)<=1%); actual written to " << out;
     }
   }
-
-  std::unique_ptr<vr::EglContext> context_;
-  std::unique_ptr<vr::StereoRenderer> renderer_;
 };
 
 vr::FrameScene burn_scene() {
@@ -107,7 +94,7 @@ vr::FrameScene burn_scene() {
   o.retina_triangles = 3000;
   vr::FrameScene s = vt::make_scene(o);
   for (auto& m : s.meshes)
-    if (m.id == vt::kRetina) m.burns.push_back({vt::retina_point(14, 250), {}, 0.45f});
+    if (m.id == vt::kRetina) m.burns.push_back({vt::retina_point(14, 250), {}, 0.45f, {}});
   return s;
 }
 
@@ -252,7 +239,7 @@ TEST_F(RenderScenes, LaserBurnAppearsWhitishWhereTheRayHit) {
   const vr::Vec3 probe{-2.0f, -3.0f, -2.0f};
   const vr::Vec3 hit = vt::ray_sphere_exit(probe, vt::retina_point(14, 250), vt::kRetinaRadius);
   vr::FrameScene with = without;
-  mesh(with, vt::kRetina)->burns.push_back({hit, {}, 0.45f});
+  mesh(with, vt::kRetina)->burns.push_back({hit, {}, 0.45f, {}});
   const vr::StereoFrame a = render(without);
   const vr::StereoFrame b = render(with);
   EXPECT_EQ(renderer_->stats().burns_painted, 1u);
@@ -266,6 +253,49 @@ TEST_F(RenderScenes, LaserBurnAppearsWhitishWhereTheRayHit) {
     const vr::Vec2 px_away = vt::project_to_pixel(with, eye, away, kW, kH);
     EXPECT_LT(std::fabs(patch(b.eye(eye), px_away).luma() - patch(a.eye(eye), px_away).luma()), 3.0);
   }
+}
+
+// The simulation hands a burn over as surface coordinates (a triangle and the barycentric point in
+// it): painted exactly as the same point given by position (which the renderer must search for),
+// and without a search, so a point given this way needs no nearby surface position at all.
+TEST_F(RenderScenes, LaserBurnFromSurfaceCoordinatesMatchesTheSearchedOne) {
+  vr::FrameScene by_position = burn_scene();
+  vr::Mesh& retina = *mesh(by_position, vt::kRetina);
+  retina.burns.clear();
+  // a triangle of the retina in view (the one nearest the usual burn point) and a point inside it
+  const vr::Vec3 target = vt::retina_point(14, 250);
+  const auto& geo = *retina.geometry;
+  std::size_t best = 0;
+  float best_d = 1e30f;
+  for (std::size_t t = 0; t < geo.indices.size() / 3; ++t) {
+    const vr::Vec3 c = (geo.vertices[geo.indices[3 * t]].position_mm + geo.vertices[geo.indices[3 * t + 1]].position_mm +
+                        geo.vertices[geo.indices[3 * t + 2]].position_mm) *
+                       (1.0f / 3.0f);
+    const float d = vr::dot(c - target, c - target);
+    if (d < best_d) best_d = d, best = t;
+  }
+  const std::array<std::uint32_t, 3> corners{geo.indices[3 * best], geo.indices[3 * best + 1], geo.indices[3 * best + 2]};
+  const std::array<float, 3> bc{0.25f, 0.35f, 0.4f};
+  const vr::Vec3 point = geo.vertices[corners[0]].position_mm * bc[0] + geo.vertices[corners[1]].position_mm * bc[1] +
+                         geo.vertices[corners[2]].position_mm * bc[2];
+  vr::FrameScene by_triangle = by_position;
+  retina.burns.push_back({point, {}, 0.45f, {}});
+  vr::LaserBurn surface_point;
+  surface_point.hit_point = vr::LaserBurn::SurfacePoint{corners, bc};
+  surface_point.radius_mm = 0.45f;
+  mesh(by_triangle, vt::kRetina)->burns.push_back(surface_point);
+  vr::FrameScene none = by_triangle;
+  mesh(none, vt::kRetina)->burns.clear();
+  // burns are painted once into the mesh's burn texture: a frame without any in between starts it clean
+  const vr::StereoFrame a = render(by_position);
+  const vr::StereoFrame clean = render(none);
+  const vr::StereoFrame b = render(by_triangle);
+  EXPECT_EQ(renderer_->stats().burns_painted, 2u) << "one in each frame that has a burn (the counts add up)";
+  EXPECT_EQ(renderer_->stats().burns_missed, 0u);
+  const vr::ImageDiff d = vr::compare_images(a.eye(0), b.eye(0), 8);
+  EXPECT_LT(d.rmse, 0.5) << d.summary();
+  const vr::Vec2 px = vt::project_to_pixel(by_triangle, 0, point, kW, kH);
+  EXPECT_GT(patch(b.eye(0), px).luma() - patch(clean.eye(0), px).luma(), 40.0) << "painted where the point lies";
 }
 
 TEST_F(RenderScenes, InstrumentCastsAShadowFromTheLightPipe) {
@@ -432,10 +462,10 @@ TEST_F(RenderScenes, BurnGivenAsUvMatchesBurnGivenAsPositionAndResetsWithTheCase
   const vr::StereoFrame clean = render(s);
   // The synthetic retina's radial uv mapping (synthetic_scene.cpp): r = 0.5·θ/95°, angle φ.
   const float theta = 14.0f, phi = 250.0f * 3.14159265f / 180.0f, r = 0.5f * theta / 95.0f;
-  retina->burns = {{vt::retina_point(theta, 250.0f), {}, 0.45f}};
+  retina->burns = {{vt::retina_point(theta, 250.0f), {}, 0.45f, {}}};
   const vr::Image by_position = render(s).side_by_side();
   vr::FrameScene s_uv = s;
-  mesh(s_uv, vt::kRetina)->burns = {{{}, vr::Vec2{0.5f + r * std::cos(phi), 0.5f + r * std::sin(phi)}, 0.45f}};
+  mesh(s_uv, vt::kRetina)->burns = {{{}, vr::Vec2{0.5f + r * std::cos(phi), 0.5f + r * std::sin(phi)}, 0.45f, {}}};
   // A fresh renderer, so the burn texture starts clean.
   renderer_ = std::make_unique<vr::StereoRenderer>(vr::RenderSettings{kW, kH, 512, 512});
   const vr::Image by_uv = render(s_uv).side_by_side();

@@ -78,6 +78,50 @@ TEST(TripleBuffer, ConcurrentWriterReaderNeverTearsAndSequenceIsMonotonic) {
   EXPECT_GT(updates, 0u);
 }
 
+// take(): only what is new, and every value the reader never saw is counted as dropped (the render
+// thread reports them as scenes it skipped).
+TEST(TripleBuffer, TakeHandsOverOnlyNewValuesAndCountsTheOnesOverwritten) {
+  TripleBuffer<int> tb(0);
+  EXPECT_EQ(tb.take(), nullptr);
+  tb.write(1);
+  tb.write(2);
+  tb.write(3);
+  const int* v = tb.take();
+  ASSERT_NE(v, nullptr);
+  EXPECT_EQ(*v, 3);
+  EXPECT_EQ(tb.dropped(), 2u);
+  EXPECT_EQ(tb.take(), nullptr) << "nothing new";
+  tb.write(4);
+  ASSERT_NE(tb.take(), nullptr);
+  EXPECT_EQ(tb.dropped(), 2u);
+  EXPECT_EQ(tb.publishes(), 4u);
+}
+
+TEST(TripleBuffer, ConcurrentlyEveryValueIsTakenOrCountedAsDropped) {
+  TripleBuffer<Stamp> tb(Stamp::make(0));
+  constexpr std::uint64_t kWrites = 200000;
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    for (std::uint64_t s = 1; s <= kWrites; ++s) tb.write(Stamp::make(s));
+    done.store(true, std::memory_order_release);
+  });
+  std::uint64_t last = 0, takes = 0;
+  for (;;) {
+    const bool finished = done.load(std::memory_order_acquire);
+    if (const Stamp* p = tb.take()) {
+      ASSERT_TRUE(p->consistent());
+      ASSERT_GT(p->seq, last);
+      last = p->seq;
+      ++takes;
+    } else if (finished) {
+      break;
+    }
+  }
+  writer.join();
+  EXPECT_EQ(last, kWrites) << "the final value is never lost";
+  EXPECT_EQ(takes + tb.dropped(), kWrites);
+}
+
 TEST(SpscRing, FifoOrderAndDropWhenFullIsCounted) {
   SpscRing<int> ring(5);  // rounded up to 8
   ASSERT_EQ(ring.capacity(), 8u);

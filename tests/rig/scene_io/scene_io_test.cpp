@@ -1,6 +1,8 @@
 // Scene files: every case in scenes/ loads, settles within its budget and has a stable state hash;
 // the corpus in bad/ gives the expected file:line errors; random mutations never crash.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -92,6 +94,33 @@ TEST(SceneFiles, CasesTheIssueAsksFor) {
   }
 }
 
+// Issue 20: files a careless user can name — a case of 2 MB (it used to run and be copied into the
+// recording), a FIFO (reading blocks for ever), a directory — are refused at once with the reason.
+TEST(SceneFiles, OversizedSpecialAndDirectoryPathsAreRefusedAtOnceWithTheReason) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("vitreo-scene-files-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream big(dir / "big.toml");
+    big << "format_version = 1\nname = \"big\"\n";
+    for (int i = 0; i < 40000; ++i) big << "# padding padding padding padding padding padding\n";
+  }
+  ASSERT_EQ(::mkfifo((dir / "fifo.toml").c_str(), 0600), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const auto& [name, says] : {std::pair<const char*, const char*>{"big.toml", "larger than 1 MiB"},
+                                   {"fifo.toml", "not a regular file"}, {".", "is a directory"}, {"none.toml", "no such file"}}) {
+    const std::string path = (dir / name).string();
+    try {
+      (void)scene_io::read_case_text(path);
+      ADD_FAILURE() << path << " was read";
+    } catch (const scene_io::SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)scene_io::load_scene_file(path), scene_io::SceneError) << path;
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5)) << "nothing blocked or read gigabytes";
+  fs::remove_all(dir);
+}
+
 class BadScene : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BadScene, GivesFileLineAndReason) {
@@ -140,6 +169,25 @@ TEST(CaseLoader, SecondLoadComesFromTheCacheWithTheSameState) {
   const auto third = scene_io::load_case(path, {dir, false});
   EXPECT_EQ(third.scene.world.state_hash(), first.scene.world.state_hash());
   std::filesystem::remove_all(dir);
+}
+
+// The [view] table: what the rig's microscope and renderer read, and its defaults when absent.
+TEST(SceneFiles, ViewTableIsReadWithItsDefaults) {
+  const core::SceneDescription plain = scene_io::parse_scene("format_version = 1\nname = \"v\"\n", "plain.toml");
+  EXPECT_FALSE(plain.view.region_of_interest.has_value());
+  EXPECT_EQ(plain.view.gel_stain, core::GelStain::kClear);
+  EXPECT_FALSE(plain.view.wide_angle);
+  EXPECT_FALSE(plain.view.chandelier);
+  const core::SceneDescription v = scene_io::parse_scene(
+      "format_version = 1\nname = \"v\"\n[view]\nregion_of_interest = { polar_deg = 55.5, azimuth_deg = 200 }\n"
+      "gel_stain = \"triamcinolone\"\nwide_angle = true\nchandelier = true\n",
+      "view.toml");
+  ASSERT_TRUE(v.view.region_of_interest.has_value());
+  EXPECT_EQ(v.view.region_of_interest->polar_deg, 55.5);
+  EXPECT_EQ(v.view.region_of_interest->azimuth_deg, 200.0);
+  EXPECT_EQ(v.view.gel_stain, core::GelStain::kTriamcinolone);
+  EXPECT_TRUE(v.view.wide_angle);
+  EXPECT_TRUE(v.view.chandelier);
 }
 
 TEST(SceneFiles, MissingFileIsAnError) {

@@ -86,12 +86,7 @@ void BM_CaseStereoFrame(benchmark::State& state, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> names;
-  for (const auto& e : std::filesystem::directory_iterator(kScenes)) {
-    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") names.push_back(e.path().stem().string());
-  }
-  std::sort(names.begin(), names.end());
-  for (const auto& n : names) {
+  for (const auto& n : rig::testing::shipped_case_names()) {
     benchmark::RegisterBenchmark(("BM_CaseStereoFrame/" + n + "/1280x1024").c_str(), BM_CaseStereoFrame, n)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(20);

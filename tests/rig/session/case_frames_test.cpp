@@ -3,11 +3,14 @@
 // poses through their trackers and ports, captured at a step boundary (capture_view), turned into a
 // FrameScene (FrameBuilder) and rendered as a small stereo frame on Mesa through surfaceless EGL.
 //
-// Each frame is compared with a checked-in golden (tolerance-based, the metric is printed; see
-// golden/README.md to regenerate), and checked against facts that do not depend on the golden: the
-// lit spot is far brighter than the unlit periphery, the retina's vessel map is what that spot shows
-// (taking the texture away changes it), a detached case shows its lifted retina greyer than the same
-// frame with the detachment shading off, and an attached case has no lifted retina at all.
+// Each frame (both eyes) is compared with a checked-in golden (tolerance-based, the metric is
+// printed; see golden/README.md to regenerate), and checked against facts that do not depend on the
+// golden: the case's region of interest is in the middle of the picture at its start; the light
+// pipe lights it (without it the spot is dark); the labels toggle changes the picture only at the
+// guides and the labels; the retina's vessel map is what the spot shows (taking the texture away
+// changes it); a detached case shows its lifted retina greyer than the same frame with the
+// detachment shading off, and an attached case has no lifted retina at all. The cues measured in
+// the image (guide, aiming spot, jaws, disparity, gel, rims, microscope) are in view_cues_test.cpp.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -25,6 +28,7 @@
 #include "rig/session/frame_source.hpp"
 #include "rig/session/simulation_model.hpp"
 #include "fixed_poses.hpp"
+#include "image_checks.hpp"
 #include "synthetic_scene.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/image_compare.hpp"
@@ -38,15 +42,6 @@ namespace {
 
 constexpr int kW = 160, kH = 128;
 const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
-
-std::vector<std::string> case_names() {
-  std::vector<std::string> out;
-  for (const auto& e : std::filesystem::directory_iterator(kScenes)) {
-    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") out.push_back(e.path().stem().string());
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 struct Rgb {
   double r = 0, g = 0, b = 0;
@@ -164,21 +159,51 @@ TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
   const vr::StereoFrame frame = render_stereo(scene);
   expect_golden(frame.side_by_side(), name);
 
-  // The lit spot (where the light pipe's axis meets the fundus) against the periphery of the image.
+  // The region of interest is inside the frame, near its centre, at the case's start (the
+  // microscope starts centred on it).
   const vr::Image left = frame.eye(0);
   const vr::Vec2 spot = render::testing::project_to_pixel(scene, 0, vr::Vec3{float(c.focus_mm.x()), float(c.focus_mm.y()), float(c.focus_mm.z())}, kW, kH);
-  ASSERT_TRUE(spot.x >= 0 && spot.x < kW && spot.y >= 0 && spot.y < kH) << "the region of interest is in view";
-  const Rgb lit = patch(left, spot, 4);
-  double dark = 1e9;
-  for (vr::Vec2 corner : {vr::Vec2{4, 4}, vr::Vec2{kW - 5.0f, 4}, vr::Vec2{4, kH - 5.0f}, vr::Vec2{kW - 5.0f, kH - 5.0f}}) {
-    dark = std::min(dark, patch(left, corner, 3).luma());
-  }
-  std::printf("%s: lit spot luma %.1f (r %.0f g %.0f b %.0f), darkest corner %.1f\n", name.c_str(), lit.luma(), lit.r, lit.g, lit.b, dark);
+  EXPECT_NEAR(spot.x, kW / 2.0f, kW / 10.0f) << "the region of interest is in the middle of the picture";
+  EXPECT_NEAR(spot.y, kH / 2.0f, kH / 10.0f);
+  // The light pipe lights it: the same frame without the light is far darker there.
+  vr::FrameScene unlit = scene;
+  unlit.light_pipe.reset();
+  unlit.chandelier.reset();
+  unlit.labels.clear();
+  vr::FrameScene lit_plain = scene;
+  lit_plain.labels.clear();
+  const vr::Image left_nolabels = render_stereo(lit_plain).eye(0);
+  const Rgb lit = patch(left_nolabels, spot, 4), dark = patch(render_stereo(unlit).eye(0), spot, 4);
+  std::printf("%s: region of interest at pixel (%.0f, %.0f): luma %.1f lit, %.1f without the light\n", name.c_str(), spot.x, spot.y, lit.luma(),
+              dark.luma());
   EXPECT_GT(lit.luma(), 30.0);
-  EXPECT_GT(lit.luma(), 3.0 * dark + 10.0) << "only the light pipe lights the interior";
+  EXPECT_GT(lit.luma(), 3.0 * dark.luma() + 10.0) << "only the light pipe lights the interior";
+  // The labels toggle (guides and structure names) changes the picture only at the guides and the
+  // labels: the same frame without them differs nowhere else.
+  if (!scene.labels.empty()) {
+    vr::FrameScene bare = scene;
+    bare.labels.clear();
+    std::erase_if(bare.meshes, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Guide; });
+    std::vector<vr::Vec2> allowed;
+    for (const auto& l : scene.labels) {
+      const vr::Vec2 a = render::testing::project_to_pixel(scene, 0, l.anchor_mm, kW, kH);
+      // The text starts right of the marker and moves down a line at a time past earlier labels.
+      for (int row = 0; row <= static_cast<int>(scene.labels.size()); ++row)
+        for (int k = -1; k < static_cast<int>(l.text.size()) + 2; ++k) allowed.push_back({a.x + 6.0f * k, a.y + 10.0f * row});
+    }
+    for (const auto& m : scene.meshes) {
+      if (m.material != vr::MaterialKind::Guide) continue;
+      for (const auto& v : m.geometry->vertices) allowed.push_back(render::testing::project_to_pixel(scene, 0, v.position_mm, kW, kH));
+    }
+    const render::testing::Mask changed = render::testing::diff_mask(left, render_stereo(bare).eye(0), 16);
+    std::printf("%s: labels and guides change %d pixels, %.3f of them at a label or a guide\n", name.c_str(), changed.count(),
+                changed.fraction_near(allowed, 6.0f));
+    EXPECT_GT(changed.count(), 0);
+    EXPECT_GT(changed.fraction_near(allowed, 6.0f), 0.97);
+  }
 
   // The vessel map is on the retina: the same frame without it differs in the lit spot.
-  vr::FrameScene plain = scene;
+  vr::FrameScene plain = lit_plain;
   for (auto& m : plain.meshes) {
     if (m.material == vr::MaterialKind::Retina) m.texture = nullptr;
   }
@@ -187,10 +212,10 @@ TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
   for (int y = 0; y < kH; ++y) {
     for (int x = 0; x < kW; ++x) {
       const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 4;
-      if (0.2126 * left.rgba[i] + 0.7152 * left.rgba[i + 1] + 0.0722 * left.rgba[i + 2] < 25.0) continue;
+      if (0.2126 * left_nolabels.rgba[i] + 0.7152 * left_nolabels.rgba[i + 1] + 0.0722 * left_nolabels.rgba[i + 2] < 25.0) continue;
       ++lit_pixels;
       int d = 0;
-      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(int(left.rgba[i + k]) - int(left_plain.rgba[i + k])));
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(int(left_nolabels.rgba[i + k]) - int(left_plain.rgba[i + k])));
       changed += d > 12;
     }
   }
@@ -230,23 +255,17 @@ TEST_P(CaseFrames, GoldenAtFixedPosesAndWhatTheFrameMustShow) {
     if (off < best_off) best_off = off, best = v.position_mm;
   }
   ASSERT_LT(best_off, 1e8f);
-  vr::FrameScene flat = scene;
-  for (auto& m : flat.meshes) {
-    if (m.material != vr::MaterialKind::Retina) continue;
-    auto g = std::make_shared<vr::MeshGeometry>(*m.geometry);
-    for (auto& v : g->vertices) v.detachment = 0.0f;
-    m.geometry = g;
-    m.geometry_version += 1000000;
-  }
+  vr::FrameScene flat = render::testing::without_detachment_shading(scene);
   const vr::Vec2 px = render::testing::project_to_pixel(scene, 0, best, kW, kH);
-  const Rgb shaded = patch(left, px, 1), unshaded = patch(render_stereo(flat).eye(0), px, 1);
+  flat.labels.clear();
+  const Rgb shaded = patch(left_nolabels, px, 1), unshaded = patch(render_stereo(flat).eye(0), px, 1);
   std::printf("%s: detached patch spread/luma %.2f vs %.2f without the shading\n", name.c_str(), shaded.spread() / std::max(shaded.luma(), 1.0),
               unshaded.spread() / std::max(unshaded.luma(), 1.0));
   EXPECT_LT(shaded.spread() / std::max(shaded.luma(), 1.0), 0.8 * unshaded.spread() / std::max(unshaded.luma(), 1.0))
       << "detached retina looks greyer";
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryCase, CaseFrames, ::testing::ValuesIn(case_names()),
+INSTANTIATE_TEST_SUITE_P(EveryCase, CaseFrames, ::testing::ValuesIn(rig::testing::shipped_case_names()),
                          [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 // The operator's view toggles reach the picture: wireframe draws the tissue's edges, zoom narrows
@@ -256,8 +275,8 @@ TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
   rig::SimulationModel& model = under_test.model;
   model.step();
   rig::FrameBuilder builder;
+  rig::ViewSnapshot v;  // reused, as the session's triple buffer is
   auto frame_of = [&] {
-    rig::ViewSnapshot v;
     EXPECT_TRUE(rig::capture_view(model, 1, 0.001, v));
     return builder.build(v);
   };
@@ -277,7 +296,8 @@ TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
   std::printf("wireframe vs filled: %s\n", dw.summary().c_str());
   EXPECT_GT(dw.fraction_over, 0.02) << "the wireframe picture differs visibly";
   command(7, 0);
-  command(9, 2.0);  // zoom 2×
+  command(9, 2.0);  // zoom 2×: the zoom motor gets there
+  for (int i = 0; i < 2000 && model.microscope().zoom() != 2.0; ++i) model.step();
   const vr::FrameScene zoomed = frame_of();
   EXPECT_FLOAT_EQ(zoomed.microscope.zoom, 2.0f);
   const vr::Vec3 disc{float(model.scene().eye.optic_disc_mm.x()), float(model.scene().eye.optic_disc_mm.y()),
@@ -286,7 +306,7 @@ TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
   const vr::Vec2 c1 = render::testing::project_to_pixel(zoomed, 0, disc, kW, kH);
   const vr::Vec2 mid{kW / 2.0f, kH / 2.0f};
   const double r0 = std::hypot(c0.x - mid.x, c0.y - mid.y), r1 = std::hypot(c1.x - mid.x, c1.y - mid.y);
-  EXPECT_NEAR(r1 / r0, 2.0, 0.15) << "zoom 2 doubles image distances from the centre";
+  EXPECT_NEAR(r1 / r0, 2.0, 0.15) << "zoom 2 doubles image distances from the centre (tan(field/2) halves)";
   EXPECT_GT(vr::compare_images(render(zoomed), render(base)).fraction_over, 0.05);
 }
 
@@ -300,7 +320,7 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   ASSERT_FALSE(c.tools.empty());
   ASSERT_EQ(c.tools[0], core::InstrumentKind::kEndolaser);
   // Aim at attached retina beside the fovea (a 0.2 mm burn needs the microscope zoomed in to span
-  // a few pixels of this small frame), with the light pipe on the same spot.
+  // a few pixels of this small frame: zoom 4, panned there), with the light pipe on the same spot.
   const core::Vec3 aim = model.scene().eye.wall_point(8.0 * std::numbers::pi / 180.0, std::numbers::pi);
   const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
@@ -310,9 +330,14 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   zoom.device_kind = rig::kCommandKind;
   zoom.n_values = 2;
   zoom.values[0] = 9;
-  zoom.values[1] = 10.0;
+  zoom.values[1] = 4.0;
+  // The microscope over the aim (a pan command from the case's region of interest; the X–Y motor is
+  // quickest at low magnification), then zoomed in.
+  const core::Vec2 offset = model.scene().eye.fundus_coords(aim) - model.microscope().region_of_interest_mm();
+  ASSERT_TRUE(model.apply(rig::testing::command_input(10, offset.x(), offset.y())));
+  for (int i = 0; i < 4000 && model.microscope().center_mm() != model.scene().eye.fundus_coords(aim); ++i) model.step();
   ASSERT_TRUE(model.apply(zoom));
-  model.step();
+  for (int i = 0; i < 4000 && model.microscope().zoom() != 4.0; ++i) model.step();
   auto pedal = [](int switches) {
     telemetry::DeviceInput in;
     in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
@@ -330,19 +355,33 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   model.step();
   ASSERT_TRUE(model.apply(pedal(0)));
   model.step();
-  ASSERT_EQ(model.instrument_system().burns().size(), 1u) << "one pulse on the rising edge";
-  const core::Vec3 hit = model.instrument_system().burn_position(model.instrument_system().burns()[0]);
-  rig::ViewSnapshot view;
-  ASSERT_TRUE(rig::capture_view(model, 3, 0.003, view));
+  ASSERT_EQ(model.simulation().burns().size(), 1u) << "one pulse on the rising edge";
+  const core::Vec3 hit = model.simulation().burn_position(model.simulation().burns()[0]);
+  // The field onto the burn while the coagulation whitens (a few hundred milliseconds).
+  const core::Vec2 to_hit = model.scene().eye.fundus_coords(hit) - model.microscope().region_of_interest_mm();
+  ASSERT_TRUE(model.apply(rig::testing::command_input(10, to_hit.x(), to_hit.y())));
+  for (int i = 0; i < 500; ++i) model.step();
+  ASSERT_TRUE(rig::capture_view(model, 3, 0.003, before_view));
+  const rig::ViewSnapshot& view = before_view;
   ASSERT_EQ(view.n_burns, 1u);
-  const vr::FrameScene after = builder.build(view);
+  vr::FrameScene after = builder.build(view);
+  // The burn, not the aiming spot still on it (light added on top) nor the labels.
+  std::erase_if(after.meshes, [](const vr::Mesh& m) { return m.material == vr::MaterialKind::Glow; });
+  after.labels.clear();
   std::size_t burns = 0;
-  for (const auto& m : after.meshes) burns += m.burns.size();
+  for (const auto& m : after.meshes) {
+    burns += m.burns.size();
+    for (const auto& b : m.burns) {
+      EXPECT_TRUE(b.hit_point.has_value()) << "the renderer gets the triangle, not a point to search for";
+      EXPECT_FALSE(b.hit_position_mm.has_value());
+    }
+  }
   EXPECT_EQ(burns, 1u);
   vr::FrameScene cleared = after;
   for (auto& m : cleared.meshes) m.burns.clear();
   const vr::Vec2 px = render::testing::project_to_pixel(after, 0, vr::Vec3{float(hit.x()), float(hit.y()), float(hit.z())}, kW, kH);
-  ASSERT_TRUE(px.x >= 0 && px.x < kW && px.y >= 0 && px.y < kH);
+  ASSERT_TRUE(px.x >= 0 && px.x < kW && px.y >= 0 && px.y < kH) << "burn at pixel (" << px.x << ", " << px.y << "), zoom "
+                                                               << model.microscope().zoom() << ", hit " << (hit - aim).norm() << " mm from the aim";
   EXPECT_LT((hit - aim).norm(), 1.0) << "the beam went where the laser was aimed";
   const Rgb with = patch(render_stereo(after).eye(0), px, 1), without = patch(render_stereo(cleared).eye(0), px, 1);
   std::printf("burn at pixel (%.1f, %.1f): luma %.1f spread %.1f vs %.1f / %.1f without\n", px.x, px.y, with.luma(), with.spread(),
@@ -382,9 +421,9 @@ TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
   ASSERT_TRUE(model.apply(pedal(1.0, 0)));       // full aspiration
   ASSERT_TRUE(model.controls().air_infusion);
   model.step();
-  const double top = model.instrument_system().fluid_level_z_mm();
+  const double top = model.simulation().fluid_level_z_mm();
   for (int i = 0; i < 400; ++i) model.step();
-  const double level = model.instrument_system().fluid_level_z_mm();
+  const double level = model.simulation().fluid_level_z_mm();
   std::printf("fluid level: %.2f mm at the start of the exchange, %.2f mm after 0.4 s of aspiration\n", top, level);
   EXPECT_NEAR(top - level, 0.4 * 2.0, 0.1) << "falls at the aspiration rate (2 mm/s at full vacuum)";
   rig::ViewSnapshot v1;

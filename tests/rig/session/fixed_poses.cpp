@@ -1,5 +1,8 @@
 #include "fixed_poses.hpp"
 
+#include <algorithm>
+#include <filesystem>
+
 namespace vitreo::rig::testing {
 
 namespace {
@@ -21,16 +24,44 @@ CaseUnderTest::CaseUnderTest(const std::string& scene_file, int retina_vertices,
     : loader({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir), /*visuals=*/true),
       model(model_config({scene_io::read_case_text(scene_file)}, load_options(retina_vertices, cache_dir)), loader.load_now(0)) {}
 
-telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation) {
+std::vector<std::string> shipped_case_names() {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(VITREO_SOURCE_DIR) + "/scenes")) {
+    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") out.push_back(e.path().stem().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation, const core::Quat& orientation) {
   telemetry::DeviceInput in;
   in.device_kind = static_cast<std::int8_t>(InputKind::Tracker);
   in.n_values = 11;
   in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
-  in.values[3] = 1.0;  // orientation: the shaft is rebuilt from the port through the tip
+  // Orientation: the shaft is rebuilt from the port through the tip; the x axis gives the roll.
+  in.values[3] = orientation.w(), in.values[4] = orientation.x(), in.values[5] = orientation.y(), in.values[6] = orientation.z();
   in.values[7] = actuation;
   in.values[8] = 1.0;
   in.values[9] = id;
   in.values[10] = 3;
+  return in;
+}
+
+telemetry::DeviceInput command_input(int code, double a, double b) {
+  telemetry::DeviceInput in;
+  in.device_kind = kCommandKind;
+  in.n_values = 3;
+  in.values[0] = code, in.values[1] = a, in.values[2] = b;
+  return in;
+}
+
+telemetry::DeviceInput pedal_input(int pedal, double a0, double a1, double a2, double a3, int switches) {
+  telemetry::DeviceInput in;
+  in.device_kind = static_cast<std::int8_t>(InputKind::Pedals);
+  in.n_values = 7;
+  in.values[0] = pedal, in.values[1] = 4;
+  in.values[2] = a0, in.values[3] = a1, in.values[4] = a2, in.values[5] = a3;
+  in.values[6] = switches;
   return in;
 }
 
@@ -39,7 +70,10 @@ bool place_at_fixed_poses(SimulationModel& model) {
   const core::Vec3 lp = c.tracker_ports[kLightPipeTracker].position_mm;
   const core::Vec3 tp = c.tracker_ports[kToolTracker].position_mm;
   if (!model.apply(tracker_sample(kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0))) return false;
-  if (!model.apply(tracker_sample(kToolTracker, tp + 5.0 * (c.focus_mm - tp).normalized(), 0.0))) return false;
+  // The tool aimed at the region of interest from its port, its tip short of it (its handle a
+  // third closed): working tips, the laser's aiming spot and the shadows all lie in the field.
+  const core::Vec3 tool_tip = c.focus_mm - kToolClearance_mm * (c.focus_mm - tp).normalized();
+  if (!model.apply(tracker_sample(kToolTracker, tool_tip, kToolActuation))) return false;
   for (int i = 0; i < 3; ++i) model.step();
   return true;
 }

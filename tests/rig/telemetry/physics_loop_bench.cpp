@@ -95,7 +95,7 @@ RunResult run_loop(Workload& work, std::uint64_t steps, bool loaded) {
       n += static_cast<std::uint64_t>(m.step >= 0);
     }
   } sub;
-  telemetry::subscribe_to<vitreo_lcm::instrument_state_t>(pub.lcm(), telemetry::kChanInstrumentState, &sub);
+  auto sub1 = telemetry::subscribe_to<vitreo_lcm::instrument_state_t>(pub.lcm(), telemetry::kChanInstrumentState, &sub);
 
   runtime::ThreadHarness* hp = nullptr;
   runtime::ThreadHarness h(clock, cfg, [&](std::uint64_t k, double t_s) {

@@ -64,11 +64,11 @@ TEST(TelemetryPublisher, MemqRoundTripOfEveryItemType) {
   Collector<vitreo_lcm::physics_timing_t> timing;
   Collector<vitreo_lcm::device_status_t> status;
   Collector<vitreo_lcm::score_t> scores;
-  subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
-  subscribe_to<decltype(events.got)::value_type>(pub.lcm(), kChanEvent, &events);
-  subscribe_to<decltype(timing.got)::value_type>(pub.lcm(), kChanPhysicsTiming, &timing);
-  subscribe_to<decltype(status.got)::value_type>(pub.lcm(), kChanDeviceStatus, &status);
-  subscribe_to<decltype(scores.got)::value_type>(pub.lcm(), kChanScore, &scores);
+  auto sub1 = subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
+  auto sub2 = subscribe_to<decltype(events.got)::value_type>(pub.lcm(), kChanEvent, &events);
+  auto sub3 = subscribe_to<decltype(timing.got)::value_type>(pub.lcm(), kChanPhysicsTiming, &timing);
+  auto sub4 = subscribe_to<decltype(status.got)::value_type>(pub.lcm(), kChanDeviceStatus, &status);
+  auto sub5 = subscribe_to<decltype(scores.got)::value_type>(pub.lcm(), kChanScore, &scores);
 
   ASSERT_TRUE(physics.push(make_state(42)));
   Event e;
@@ -133,7 +133,7 @@ TEST(TelemetryPublisher, FullRingDropsAndCountsInsteadOfWaiting) {
   TelemetrySource& physics = pub.add_source("physics");
   TelemetrySource& driver = pub.add_source("tracker-driver", 4);
   Collector<vitreo_lcm::instrument_state_t> states;
-  subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
+  auto sub6 = subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
   // The telemetry thread is "stuck": nobody pumps. Producers keep going.
   std::uint64_t accepted = 0;
   for (int i = 0; i < 100; ++i) accepted += physics.push(make_state(i)) ? 1 : 0;
@@ -177,7 +177,7 @@ TEST(TimingReporter, PublishesWindowedLoopTimingEveryNSteps) {
   TelemetryPublisher pub(PublisherConfig{"memq://", 64});
   TelemetrySource& physics = pub.add_source("physics");
   Collector<vitreo_lcm::physics_timing_t> timing;
-  subscribe_to<vitreo_lcm::physics_timing_t>(pub.lcm(), kChanPhysicsTiming, &timing);
+  auto sub7 = subscribe_to<vitreo_lcm::physics_timing_t>(pub.lcm(), kChanPhysicsTiming, &timing);
   vitreo::runtime::SimulatedClock clock;
   vitreo::runtime::FixedStepLoop* loop_ptr = nullptr;
   std::unique_ptr<TimingReporter> reporter;
@@ -243,7 +243,7 @@ TEST(TelemetryPublisher, StalledSubscriberDoesNotSlowThePhysicsSide) {
         while (stall && !done->load(std::memory_order_acquire)) std::this_thread::yield();
       }
     } sub{stall, &physics_done, &in_handler};
-    subscribe_to<vitreo_lcm::instrument_state_t>(pub.lcm(), kChanInstrumentState, &sub);
+    auto sub8 = subscribe_to<vitreo_lcm::instrument_state_t>(pub.lcm(), kChanInstrumentState, &sub);
     std::thread telemetry([&] {
       while (!physics_done.load(std::memory_order_acquire)) {
         pub.pump();

@@ -8,11 +8,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -22,6 +24,7 @@
 #include "rig/runtime/clock.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "tests/rig/telemetry/lcm_bytes.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/recording_header_t.hpp"
 
@@ -30,6 +33,8 @@ using vitreo::runtime::SimulatedClock;
 using vitreo::runtime::SteadyClock;
 
 namespace {
+constexpr std::uint64_t kFinalHash = 0x0123456789abcdefULL;
+
 std::string temp_path(const std::string& stem) {
   return ::testing::TempDir() + stem + "-" + std::to_string(::getpid()) + ".lcmlog";
 }
@@ -77,9 +82,52 @@ std::vector<DeviceInput> record(const std::string& path, int n) {
     EXPECT_TRUE(rec.push(sent.back()));
     if (i % 50 == 49) rec.pump(i * 1'000'000LL);
   }
-  rec.close();
+  EXPECT_TRUE(rec.finish(RecordingEnd{n, kFinalHash, "test done"}));
   EXPECT_EQ(rec.written(), static_cast<std::uint64_t>(n));
   return sent;
+}
+
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const std::string& path, const std::vector<std::uint8_t>& b) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  f.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+}
+
+// Offsets of the events in an LCM log, found by walking its framing independently of the reader.
+struct EventSpan {
+  std::size_t at, header_end, end;
+  std::string channel;
+};
+std::vector<EventSpan> event_spans(const std::vector<std::uint8_t>& b) {
+  auto be32 = [&](std::size_t i) {
+    return (static_cast<std::uint32_t>(b[i]) << 24) | (static_cast<std::uint32_t>(b[i + 1]) << 16) |
+           (static_cast<std::uint32_t>(b[i + 2]) << 8) | b[i + 3];
+  };
+  std::vector<EventSpan> out;
+  for (std::size_t at = 0; at + 28 <= b.size();) {
+    const std::uint32_t ch = be32(at + 20), len = be32(at + 24);
+    const std::size_t end = at + 28 + ch + len;
+    out.push_back({at, at + 28, end, std::string(b.begin() + static_cast<long>(at + 28), b.begin() + static_cast<long>(at + 28 + ch))});
+    at = end;
+  }
+  return out;
+}
+
+// The inputs of a recording that is not whole must be a prefix of what was sent, ending before the
+// step it is trusted through.
+void expect_verified_prefix(const Recording& rec, const std::vector<DeviceInput>& sent) {
+  ASSERT_LE(rec.inputs.size(), sent.size());
+  for (std::size_t i = 0; i < rec.inputs.size(); ++i) ASSERT_TRUE(rec.inputs[i] == sent[i]) << i;
+  if (!rec.inputs.empty()) {
+    EXPECT_LE(rec.inputs.back().step, rec.trusted_through_step);
+  }
+  if (rec.inputs.size() < sent.size()) {
+    EXPECT_LT(rec.trusted_through_step, sent[rec.inputs.size()].step + 1);
+  }
 }
 
 long file_size(const std::string& path) {
@@ -92,12 +140,18 @@ TEST(Recording, RoundTripIsBitExactAndCarriesTheHeader) {
   const std::string path = temp_path("rec-roundtrip");
   const auto sent = record(path, 500);
   const Recording rec = read_recording(path);
+  EXPECT_EQ(rec.verdict, RecordingVerdict::Complete) << rec.describe();
   EXPECT_FALSE(rec.truncated);
+  ASSERT_TRUE(rec.end.has_value());
+  EXPECT_EQ(rec.end->steps, 500);
+  EXPECT_EQ(rec.end->state_hash, kFinalHash);
+  EXPECT_EQ(rec.end->stop_reason, "test done");
+  EXPECT_EQ(rec.trusted_through_step, 499);
   EXPECT_EQ(rec.header.case_id, "rrd-superior-01");
   EXPECT_EQ(rec.header.config_text, make_header().config_text);
   EXPECT_EQ(rec.header.snapshot_ref, "snapshots/rrd-superior-01.start.vsnap");
   EXPECT_EQ(rec.header.snapshot_hash, "9e3779b97f4a7c15");
-  EXPECT_EQ(rec.header.format_version, 1);
+  EXPECT_EQ(rec.header.format_version, 2);
   EXPECT_GT(rec.header.utime_us, 0);
   ASSERT_EQ(rec.inputs.size(), sent.size());
   for (std::size_t i = 0; i < sent.size(); ++i) ASSERT_TRUE(rec.inputs[i] == sent[i]) << "input " << i;
@@ -113,7 +167,7 @@ TEST(Recording, RecorderRingDropsAndCountsWhenTheRecorderThreadLags) {
   for (int i = 0; i < 100; ++i) accepted += rec.push(make_input(i)) ? 1 : 0;
   EXPECT_EQ(accepted, 32);
   EXPECT_EQ(rec.dropped(), 68u);
-  rec.close();
+  EXPECT_TRUE(rec.finish(RecordingEnd{100, 1, "test"}));
   EXPECT_EQ(read_recording(path).inputs.size(), 32u);
   std::remove(path.c_str());
 }
@@ -172,16 +226,93 @@ TEST(Recording, WriteFailureStopsRecordingWithoutStoppingTheSession) {
   std::remove(path.c_str());
 }
 
-TEST(Recording, TruncatedLogReadsUpToTheCut) {
+// Cut anywhere: truncated, never complete, and what comes back is a verified prefix.
+TEST(RecordingVerdicts, ACutRecordingIsTruncatedAndReplaysAVerifiedPrefix) {
   const std::string path = temp_path("rec-trunc");
-  const auto sent = record(path, 200);
-  const long full = file_size(path);
-  ASSERT_EQ(::truncate(path.c_str(), full - 37), 0);  // cut inside the last event
-  const Recording rec = read_recording(path);
-  EXPECT_TRUE(rec.truncated);
-  ASSERT_EQ(rec.inputs.size(), 199u);
-  for (std::size_t i = 0; i < rec.inputs.size(); ++i) ASSERT_TRUE(rec.inputs[i] == sent[i]);
+  const std::string cut = temp_path("rec-trunc-cut");
+  const auto sent = record(path, 300);
+  const auto bytes = read_bytes(path);
+  const auto spans = event_spans(bytes);
+  ASSERT_EQ(spans.back().channel, kChanRecEnd);
+  // Inside the end event, exactly before it, inside an input, at an event boundary mid-file.
+  for (std::size_t keep : {bytes.size() - 1, spans.back().at, spans[spans.size() / 2].at + 40, spans[spans.size() / 2].at,
+                           spans[1].at + 3}) {
+    write_bytes(cut, {bytes.begin(), bytes.begin() + static_cast<long>(keep)});
+    const Recording rec = read_recording(cut);
+    EXPECT_EQ(rec.verdict, RecordingVerdict::Truncated) << keep << ": " << rec.describe();
+    EXPECT_TRUE(rec.truncated);
+    EXPECT_FALSE(rec.end.has_value());
+    expect_verified_prefix(rec, sent);
+    EXPECT_NE(rec.describe().find("truncated"), std::string::npos);
+  }
   std::remove(path.c_str());
+  std::remove(cut.c_str());
+}
+
+// A byte changed anywhere the checksum or the framing covers (all but the log's own timestamps,
+// RECORDING.md): corrupted at or before that byte, and the replayable part is a verified prefix.
+TEST(RecordingVerdicts, AChangedByteAnywhereIsACorruptionFoundAtOrBeforeIt) {
+  const std::string path = temp_path("rec-flip");
+  const std::string bad = temp_path("rec-flip-bad");
+  const auto sent = record(path, 300);
+  const auto bytes = read_bytes(path);
+  const auto spans = event_spans(bytes);
+  int tried = 0;
+  for (std::size_t e = 0; e < spans.size(); e += 7) {
+    const EventSpan& sp = spans[e];
+    // sync word, event number, channel length, data length, channel name, first and last data byte
+    for (std::size_t off : {sp.at + 1, sp.at + 11, sp.at + 23, sp.at + 27, sp.header_end + 2, sp.end - sp.channel.size() / 2 - 1,
+                            sp.end - 1}) {
+      auto copy = bytes;
+      copy[off] ^= 0x10;
+      write_bytes(bad, copy);
+      ++tried;
+      if (e == 0) {  // the header: unreadable, or corrupted at byte 0 with nothing to replay
+        try {
+          const Recording rec = read_recording(bad);
+          EXPECT_EQ(rec.verdict, RecordingVerdict::Corrupted) << off;
+          EXPECT_EQ(rec.bad_byte, 0u);
+          EXPECT_TRUE(rec.inputs.empty());
+        } catch (const RecordingError&) {
+        }
+        continue;
+      }
+      const Recording rec = read_recording(bad);
+      EXPECT_EQ(rec.verdict, RecordingVerdict::Corrupted) << "byte " << off << " of event " << e << " (" << sp.channel << "): " << rec.describe();
+      EXPECT_LE(rec.bad_byte, off);
+      expect_verified_prefix(rec, sent);
+    }
+  }
+  EXPECT_GT(tried, 100);
+  std::remove(path.c_str());
+  std::remove(bad.c_str());
+}
+
+TEST(RecordingVerdicts, DataAfterTheEndAndConcatenatedRecordingsAreCorruptionsAfterACompleteOne) {
+  const std::string path = temp_path("rec-whole");
+  const std::string more = temp_path("rec-more");
+  const auto sent = record(path, 120);
+  const auto bytes = read_bytes(path);
+  auto appended = bytes;
+  for (int i = 0; i < 100; ++i) appended.push_back(static_cast<std::uint8_t>(i * 37));
+  write_bytes(more, appended);
+  Recording rec = read_recording(more);
+  EXPECT_EQ(rec.verdict, RecordingVerdict::Corrupted);
+  EXPECT_EQ(rec.bad_byte, bytes.size());
+  EXPECT_NE(rec.problem.find("100 bytes after the end"), std::string::npos) << rec.problem;
+  ASSERT_TRUE(rec.end.has_value()) << "the recording before the garbage is whole";
+  EXPECT_EQ(rec.inputs.size(), sent.size());
+
+  auto twice = bytes;
+  twice.insert(twice.end(), bytes.begin(), bytes.end());
+  write_bytes(more, twice);
+  rec = read_recording(more);
+  EXPECT_EQ(rec.verdict, RecordingVerdict::Corrupted);
+  EXPECT_EQ(rec.bad_byte, bytes.size());
+  EXPECT_NE(rec.problem.find("another recording starts"), std::string::npos) << rec.problem;
+  EXPECT_EQ(rec.inputs.size(), sent.size());
+  std::remove(path.c_str());
+  std::remove(more.c_str());
 }
 
 TEST(Recording, RejectsFilesThatAreNotRecordings) {
@@ -214,6 +345,33 @@ TEST(Recording, RejectsFilesThatAreNotRecordings) {
   std::remove(future.c_str());
 }
 
+// Issue 20: a header whose first string length is INT_MIN made `vitreo --replay` segfault. Now it
+// is a recording that does not start with a header, said with the file's name.
+TEST(Recording, HeaderWithStringLengthIntMinIsRefusedWithTheFilesName) {
+  const std::string path = temp_path("rec-header-intmin");
+  {
+    vitreo::test::LcmBytes b;
+    b.i64(vitreo_lcm::recording_header_t::getHash()).i64(1).i32(1).str_len(INT_MIN).bytes(64, 'x');
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+    std::vector<std::uint8_t> data = b.data();
+    lcm::LogEvent ev{};
+    ev.eventnum = 0;
+    ev.timestamp = 1;
+    ev.channel = kChanRecHeader;
+    ev.datalen = static_cast<std::int32_t>(data.size());
+    ev.data = data.data();
+    ASSERT_EQ(log.writeEvent(&ev), 0);
+  }
+  try {
+    read_recording(path);
+    ADD_FAILURE() << "a header with a length of INT_MIN was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
+}
+
 // The real lcm-logplayer reads our log and republishes every event through LCM's file provider;
 // the log it produces must carry the same events, bytes for bytes.
 TEST(Recording, LcmLogplayerReplaysOurLogEventForEvent) {
@@ -243,9 +401,13 @@ TEST(Recording, LcmLogplayerReplaysOurLogEventForEvent) {
     EXPECT_EQ(std::memcmp(data.data(), eb->data, data.size()), 0) << "event " << n;
     ++n;
   }
-  EXPECT_EQ(n, 301);  // header + 300 inputs
-  // And our reader accepts what the tool wrote.
-  EXPECT_EQ(read_recording(out).inputs.size(), 300u);
+  const Recording ours = read_recording(path);
+  EXPECT_EQ(static_cast<std::uint64_t>(n), ours.events);  // header, 300 inputs, checksums, end
+  // And our reader accepts what the tool wrote, checksums included (they do not cover the
+  // timestamps and event numbers the tool rewrites).
+  const Recording theirs = read_recording(out);
+  EXPECT_EQ(theirs.verdict, RecordingVerdict::Complete) << theirs.describe();
+  EXPECT_EQ(theirs.inputs.size(), 300u);
   std::remove(path.c_str());
   std::remove(out.c_str());
 }
@@ -318,9 +480,10 @@ TEST(Replay, InputCursorFeedsEachStepItsInputs) {
 }
 
 // A child records a 1 kHz input stream in real time and reports progress through a pipe; the
-// parent SIGKILLs it mid-stream. Everything the child recorded more than a second before the kill
-// must be readable, in order, with the header.
-TEST(Recording, SurvivesSigkillUpToTheLastSecond) {
+// parent SIGKILLs it mid-stream. The recording reads as truncated, holds a verified prefix, and
+// loses at most 100 ms of input (issue 20) — measured against what the child had really pushed,
+// read from the pipe after the kill.
+TEST(Recording, SigkillLosesAtMost100MsOfInput) {
   const std::string path = temp_path("rec-sigkill");
   int fds[2];
   ASSERT_EQ(::pipe(fds), 0);
@@ -328,7 +491,7 @@ TEST(Recording, SurvivesSigkillUpToTheLastSecond) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     ::close(fds[0]);
-    Recorder rec(path, make_header());  // default: flush every 100 ms
+    Recorder rec(path, make_header());  // default flush interval
     SteadyClock clock;
     const std::int64_t t0 = clock.now_ns();
     for (std::int64_t i = 0;; ++i) {
@@ -347,16 +510,18 @@ TEST(Recording, SurvivesSigkillUpToTheLastSecond) {
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  while (::read(fds[0], &v, sizeof v) == static_cast<ssize_t>(sizeof v)) last_pushed = v;  // what it really pushed
   ::close(fds[0]);
   ASSERT_GE(last_pushed, 1500) << "child stopped early";
 
   const Recording rec = read_recording(path);
+  EXPECT_EQ(rec.verdict, RecordingVerdict::Truncated) << rec.describe();
   EXPECT_EQ(rec.header.case_id, "rrd-superior-01");
   const auto n = static_cast<std::int64_t>(rec.inputs.size());
   for (std::int64_t i = 0; i < n; ++i) ASSERT_TRUE(rec.inputs[static_cast<std::size_t>(i)] == make_input(i)) << i;
-  std::printf("SIGKILL after input %lld: %lld inputs readable (lost %lld ms of a 1 kHz stream)\n",
-              static_cast<long long>(last_pushed), static_cast<long long>(n),
-              static_cast<long long>(last_pushed + 1 - n));
-  EXPECT_GE(n, last_pushed + 1 - 1000) << "more than one second was lost";
+  const double lost_ms = static_cast<double>(make_input(last_pushed).host_time_us - make_input(n).host_time_us) * 1e-3;
+  std::printf("SIGKILL after input %lld: %lld inputs replayable, %.0f ms of input lost\n", static_cast<long long>(last_pushed),
+              static_cast<long long>(n), lost_ms);
+  EXPECT_LE(lost_ms, 100.0);
   std::remove(path.c_str());
 }

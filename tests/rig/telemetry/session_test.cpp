@@ -77,6 +77,7 @@ TEST(Session, RecordedSessionReplaysToTheSameStateHash) {
   telemetry::RecordingHeader header;
   header.case_id = "toy";
   header.config_text = "toy model, tracker at ~5 kHz";
+  header.snapshot_hash = "0000000000000001";
   telemetry::Recorder recorder(path, header);
 
   ToyModel live;
@@ -133,13 +134,14 @@ TEST(Session, RecordedSessionReplaysToTheSameStateHash) {
   stop_device.store(true, std::memory_order_release);
   device.join();
   h.stop();
-  recorder.close();
+  ASSERT_TRUE(recorder.finish(telemetry::RecordingEnd{static_cast<std::int64_t>(kSteps), live.hash(), "toy done"}));
   ASSERT_EQ(h.loop().stats().steps, kSteps);
   ASSERT_EQ(recorder.dropped(), 0u);
   ASSERT_GT(live.inputs, kSteps / 2) << "the device kept up";
 
   // Replay: same model, inputs handed to the steps that consumed them, simulated clock.
   const telemetry::Recording rec = telemetry::read_recording(path);
+  EXPECT_EQ(rec.verdict, telemetry::RecordingVerdict::Complete) << rec.describe();
   EXPECT_EQ(rec.header.case_id, "toy");
   ASSERT_EQ(rec.inputs.size(), live.inputs);
   ToyModel replayed;

@@ -63,4 +63,13 @@ cat "$tmp/c3"; [ $rc -eq 1 ] && grep -q "previous_case: refused: already at the 
 wait $sub; sub=
 cat "$tmp/resp.out"
 grep -q "2 accepted, 2 refused" "$tmp/resp.out"
+echo "--- malformed acknowledgements (string lengths INT_MIN and 0) before the real one: vitreo-cmd ignores them"
+"$probe" respond-noisy "" 1 20 >"$tmp/resp2.out" 2>&1 &
+sub=$!
+for _ in $(seq 100); do grep -q responding "$tmp/resp2.out" && break; sleep 0.05; done
+rc=0; "$cmd" --source ci2 --timeout-ms 5000 wireframe >"$tmp/c4" 2>"$tmp/c4.err" || rc=$?
+cat "$tmp/c4" "$tmp/c4.err"
+[ $rc -eq 0 ] && grep -q "toggle_wireframe: accepted" "$tmp/c4" \
+  && grep -q "ignored 2 malformed packet(s) on VITREO_COMMAND_ACK" "$tmp/c4.err"
+wait $sub; sub=
 echo "udpm in a private namespace: OK"

@@ -11,7 +11,8 @@
 //    12  u32      header_bytes     128
 //    16  u32      width            full image width in pixels (both eyes side by side)
 //    20  u32      height           pixels
-//    24  u32      eye_width        width of one eye (= width/2; the left eye is the left half)
+//    24  u32      eye_width        width of one eye: width/2 for a stereo ring (the left eye is the left
+//                                  half); = width for a one-picture ring (the instructor's view)
 //    28  u32      format           1 = RGBA8, 4 bytes per pixel, rows top to bottom, no padding
 //    32  u32      slot_count       number of slots (≥ 2)
 //    36  u32      slot_header_bytes 64
@@ -74,14 +75,17 @@ inline constexpr std::uint32_t kFrameFormatRgba8 = 1;
 
 class FrameRingWriter {
  public:
-  /// Creates (or replaces) the shared-memory object `name` ("/something"). Throws std::runtime_error.
-  FrameRingWriter(std::string name, int eye_width, int height, int slot_count = 3);
+  /// Creates (or replaces) the shared-memory object `name` ("/something") for frames of `eyes`
+  /// (2: stereo side by side; 1: one picture) of eye_width×height. Throws std::runtime_error.
+  FrameRingWriter(std::string name, int eye_width, int height, int slot_count = 3, int eyes = 2);
   ~FrameRingWriter();  // unmaps and unlinks the object
   FrameRingWriter(const FrameRingWriter&) = delete;
   FrameRingWriter& operator=(const FrameRingWriter&) = delete;
 
   /// Copies `frame` into the next slot. Never blocks. Throws std::invalid_argument on a size mismatch.
   void write(const StereoFrame& frame);
+  /// A one-picture ring's frame (or a whole stereo image); `image` must match the ring's size.
+  void write(const Image& image, double sim_time_s, std::uint64_t step_index, std::uint64_t frame_index);
   /// Lower-level form: `rgba` must hold width*height*4 bytes.
   void write(const std::uint8_t* rgba, double sim_time_s, std::uint64_t step_index, std::uint64_t frame_index);
   std::uint64_t frames_written() const { return sequence_; }

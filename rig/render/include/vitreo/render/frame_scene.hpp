@@ -10,9 +10,11 @@
 // anterior (toward the microscope). The patient is supine and the surgeon looks down −z through the
 // microscope, so "deeper into the eye" is "downward" for the surgeon — the orientation the thesis'
 // surgeons asked for after complaining the prototype's axes were reversed.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "vitreo/render/math.hpp"
@@ -33,8 +35,11 @@ enum class MaterialKind : std::uint8_t {
   Choroid,     // `texture` = choroid colour (opaque)
   Static,      // sclera, lens, iris, ports: opaque, `texture` or tint
   Membrane,    // epiretinal / fibrovascular membrane: whitish, translucent
-  Gel,         // vitreous gel: hazy, mostly transparent
-  Instrument,  // metallic
+  Gel,         // vitreous gel: a faint haze thickest where seen edge-on; `texture` = stain (white crystals)
+  Instrument,  // metallic; `tint` colours it (silicone soft tip, laser fibre, …)
+  Guide,       // a task guide on the fundus (cut path, laser ring, target): unlit; Vertex::highlight = done 0..1
+  Glow,        // light itself (aiming spot and beam, the light pipe's cone and tip): added, unlit;
+               // `tint` × Vertex::highlight is its radiance
 };
 
 struct Vertex {
@@ -44,6 +49,9 @@ struct Vertex {
   /// Retina only: 0 = attached, 1 = detached (greyish, more opaque); blends in between. Lets one
   /// mesh carry a local detachment whose border moves as the simulation lifts or reattaches it.
   float detachment = 0.0f;
+  /// Retina: 1 on a cut edge or tear (rolled, whiter rim), fading to 0 a step inward.
+  /// Guide: 1 where that part of the task is done (cut, lasered). Glow: radiance 0..1.
+  float highlight = 0.0f;
 };
 
 /// Vertex data and triangle list of one mesh. Removed tissue is simply absent from `indices`.
@@ -55,12 +63,22 @@ using MeshGeometryPtr = std::shared_ptr<const MeshGeometry>;
 
 /// A laser burn on one mesh, painted once into that mesh's burn texture (in its uv space, so the
 /// burn moves with the tissue and sits exactly where the ray hit, not at the nearest vertex — the
-/// thesis' "geometry dependence" complaint). Give the hit either as a surface point (the renderer
-/// finds the triangle and its barycentric uv) or directly as uv.
+/// thesis' "geometry dependence" complaint). Give the hit as surface coordinates (the triangle, by
+/// its three vertex indices into the mesh, and the barycentric point in it: what the simulation
+/// knows, so nothing is searched), or as a point on the current surface (the renderer finds the
+/// nearest triangle), or directly as uv.
 struct LaserBurn {
-  std::optional<Vec3> hit_position_mm;  // on the mesh's *current* surface
-  std::optional<Vec2> hit_uv;           // used when hit_position_mm is empty
+  struct SurfacePoint {
+    std::array<std::uint32_t, 3> corners{};   // vertex indices of the hit triangle
+    std::array<float, 3> barycentric{1, 0, 0};
+  };
+  std::optional<Vec3> hit_position_mm;  // on the mesh's *current* surface; used without hit_point
+  std::optional<Vec2> hit_uv;           // used without either
   float radius_mm = 0.25f;              // soft edge from 0.6·radius out to radius
+  std::optional<SurfacePoint> hit_point;  // preferred when given
+  /// Seconds since the pulse: coagulated retina whitens over FrameScene::burn_whitening_s (grey at
+  /// first, whitish after a few hundred milliseconds).
+  float age_s = 1e9f;
 };
 
 struct Mesh {
@@ -93,6 +111,24 @@ struct LightPipe {
   float range_mm = 18.0f;        // distance at which the light has fallen to half (1/(1+(d/range)²))
 };
 
+/// A structure's name drawn beside it (the labels toggle): a marker at `anchor_mm` and the text to
+/// its right, placed per eye so the label sits at the structure's depth.
+struct Label {
+  Vec3 anchor_mm;
+  std::string text;
+  Vec3 colour{0.95f, 0.95f, 0.85f};
+};
+
+/// What the instructor's view adds over the surgeon's picture (RenderThreadOptions::instructor_ring):
+/// text lines (score, criteria, elapsed time), the retina contact force as a bar against its
+/// damage limit, and the latest events.
+struct InstructorOverlay {
+  std::vector<std::string> lines;
+  float retina_force_un = 0.0f;
+  float force_limit_un = 3000.0f;
+  std::vector<std::string> events;  // newest last
+};
+
 /// Fluid–gas exchange: everything on the `up` side of the plane dot(p, up) = level_mm is gas.
 struct FluidGas {
   Vec3 up{0, 0, 1};              // opposite gravity, in the eye frame (supine patient: +z)
@@ -114,9 +150,16 @@ struct Microscope {
   float focus_distance_mm = -1.0f;
   bool depth_of_field = false;
   float aperture_mm = 3.0f;      // depth-of-field strength
-  bool wide_angle = false;       // contact-lens-like wide field from just above the cornea
-  float wide_field_deg = 80.0f;    // vertical field angle in wide-angle mode (reaches the equator)
-  float wide_distance_mm = 16.0f;  // camera height above the globe centre in wide-angle mode (just above the cornea)
+  /// Seen through the eye's optics (a contact lens or a wide-angle viewing system) instead of from
+  /// outside: a virtual camera at `view_point_mm` (default: on the axis at wide_distance_mm) looks at
+  /// the target with a field angle of wide_field_deg / zoom.
+  bool wide_angle = false;
+  float wide_field_deg = 80.0f;    // vertical field angle at zoom 1 (80°: reaches the equator)
+  float wide_distance_mm = 16.0f;  // default viewpoint height above the globe centre (just above the cornea)
+  std::optional<Vec3> view_point_mm;
+  /// A wide-angle system's image without its re-inverter: what reaches the eyepieces is rotated 180°
+  /// and the two eyes' images are swapped (pseudoscopic depth), as on a real rig.
+  bool image_inverted = false;
 };
 
 struct FrameScene {
@@ -124,12 +167,17 @@ struct FrameScene {
   std::uint64_t step_index = 0;
   std::vector<Mesh> meshes;
   std::optional<LightPipe> light_pipe;
+  std::optional<LightPipe> chandelier;  // a fixed wide-angle fibre (no shadows of its own when a light pipe is in)
   std::optional<FluidGas> fluid_gas;
   Microscope microscope;
   float globe_radius_mm = 12.0f;  // inner radius of the globe: bounds the haze and the gas bubble
   float ambient = 0.025f;         // dim ambient (stray light through the sclera and pupil)
   float haze_density_per_mm = 0.02f;  // infusion/vitreous scattering
   bool wireframe = false;         // deformable tissue (retina, membranes, gel) drawn as triangle edges
+  bool flat_shading = false;      // one normal per triangle (the thesis' F2) instead of smooth normals
+  float burn_whitening_s = 0.3f;  // time constant of a laser burn's whitening (LaserBurn::age_s)
+  std::vector<Label> labels;      // drawn on top of both eyes, at each anchor's depth
+  std::optional<InstructorOverlay> instructor;  // for the instructor's view only; the eyes never show it
 };
 
 /// Per-kind defaults used when a Mesh leaves opacity / casts_shadow unset.

@@ -1,7 +1,7 @@
 #pragma once
 // RenderThread: renders the latest FrameScene on its own thread, with its own EGL context.
 //
-// The physics side only calls publish(), which is wait-free (LatestSlot): rendering can never slow
+// The physics side only calls publish(), which is wait-free (runtime::TripleBuffer): rendering can never slow
 // the simulation down; if rendering is slower than physics, intermediate scenes are skipped (and
 // counted). Each rendered frame carries the sim time and step index of the scene it shows and is
 // handed to the sinks: the shared-memory ring (if named), PNG files on request, and a callback.
@@ -19,7 +19,7 @@
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/frame_scene.hpp"
 #include "vitreo/render/kms_display.hpp"
-#include "vitreo/render/latest_slot.hpp"
+#include "rig/runtime/triple_buffer.hpp"
 #include "vitreo/render/renderer.hpp"
 
 namespace vitreo::render {
@@ -29,6 +29,10 @@ struct RenderThreadOptions {
   RenderSettings render;
   std::string shm_ring_name;  // empty: no shared-memory ring
   int shm_ring_slots = 3;
+  /// The instructor's view (instructor_view.hpp): the left eye with the scene's InstructorOverlay,
+  /// into its own one-picture ring (empty: none) and, with png_dir, beside each PNG series as
+  /// <prefix>_instructor.png. Scenes without an overlay show the plain left eye there.
+  std::string instructor_ring_name;
   /// Stereo frames of a run as PNGs (issue 8: "a few along the way and the last one"): when set, every
   /// png_every_frames-th rendered frame (0: none along the way) and the last frame rendered before
   /// stop() are written to <png_dir>/step_<step>_{left,right,stereo}.png. The directory must exist.
@@ -77,7 +81,7 @@ class RenderThread {
   void run(std::promise<void>& started);
   void present_on_displays(const StereoFrame& frame, std::vector<std::unique_ptr<KmsDisplay>>& displays);
   RenderThreadOptions options_;
-  LatestSlot<FrameScene> mailbox_;
+  runtime::TripleBuffer<FrameScene> mailbox_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> wake_{0};  // bumped by publish()/stop(); the render thread sleeps on it
   std::atomic<std::uint64_t> frames_{0};

@@ -1,0 +1,24 @@
+// libFuzzer target: the terminal's command lines (parse_command_line). A line it accepts must hold
+// a known command, a finite zoom, a valid snapshot name — whatever the bytes.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+#include "rig/telemetry/commands.hpp"
+
+using namespace vitreo::telemetry;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string line(reinterpret_cast<const char*>(data), size);
+  const ParsedCommand p = parse_command_line(line, "terminal", 1);
+  if (!p.ok) {
+    if (p.error.empty()) std::abort();
+    return 0;
+  }
+  const auto code = static_cast<CommandCode>(p.command.command);
+  if (check_command(p.command, CommandLimits{1.0, 1e300}).accepted == false && code != CommandCode::Zoom) std::abort();
+  if (code == CommandCode::SaveSnapshot && !valid_snapshot_name(p.command.arg)) std::abort();
+  if (code == CommandCode::Zoom && !std::isfinite(p.command.value)) std::abort();
+  return 0;
+}

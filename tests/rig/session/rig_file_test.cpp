@@ -1,0 +1,134 @@
+// Rig files (rig/session/rig_file.hpp): every file in rig/config/ reads; a bad file is refused with
+// its file, line and key; what the files say reaches the devices (identity, rate, scripts).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "drivers/device_uri.hpp"
+#include "rig/session/rig_file.hpp"
+
+using namespace vitreo;
+
+namespace {
+
+const std::string kConfig = std::string(VITREO_SOURCE_DIR) + "/rig/config";
+
+std::string error_of(const std::string& text, const std::string& base = "/nonexistent") {
+  try {
+    rig::parse_rig_file(text, "t.toml", base);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return {};
+}
+
+const char* kHead = "[rig]\nversion = 1\n";
+const char* kTracker = "[[device]]\nname = \"tracker\"\nrole = \"tracker\"\nuri = \"usb:1209:7a11\"\nid = 1\n";
+
+}  // namespace
+
+TEST(RigFile, EveryShippedRigFileReads) {
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(kConfig)) {
+    if (e.path().extension() != ".toml") continue;
+    ++files;
+    SCOPED_TRACE(e.path().string());
+    const rig::RigFile f = rig::read_rig_file(e.path().string());
+    EXPECT_FALSE(f.name.empty());
+    ASSERT_EQ(f.devices.size(), 3u) << "tracker, pedals and eyeball";
+    EXPECT_EQ(f.devices[0].role, rig::DeviceRole::tracker);
+    EXPECT_EQ(f.devices[1].role, rig::DeviceRole::pedals);
+    EXPECT_EQ(f.devices[2].role, rig::DeviceRole::eyeball);
+    for (const auto& d : f.devices) {
+      drivers::DeviceUri uri;
+      std::string why;
+      EXPECT_TRUE(drivers::parse_device_uri(d.uri, uri, &why)) << why;
+    }
+  }
+  EXPECT_GE(files, 3);
+}
+
+TEST(RigFile, TheMixedRigUsesAllThreeTransports) {
+  const rig::RigFile f = rig::read_rig_file(kConfig + "/sim-mixed.toml");
+  std::vector<drivers::Transport> transports;
+  for (const auto& d : f.devices) {
+    drivers::DeviceUri uri;
+    ASSERT_TRUE(drivers::parse_device_uri(d.uri, uri, nullptr));
+    EXPECT_EQ(uri.scheme, drivers::DeviceUri::Scheme::sim);
+    transports.push_back(uri.transport());
+  }
+  EXPECT_EQ(transports, (std::vector<drivers::Transport>{drivers::Transport::usb, drivers::Transport::serial, drivers::Transport::can}));
+}
+
+TEST(RigFile, TheBuiltRigNamesRealDevicesAndCarriesThePedalMapping) {
+  const rig::RigFile f = rig::read_rig_file(kConfig + "/default-rig.toml");
+  EXPECT_EQ(f.devices[0].uri, "usb:1209:7a11");
+  EXPECT_EQ(f.devices[1].uri, "serial:/dev/vitreo/pedals");
+  EXPECT_EQ(f.devices[2].uri, "can:can0?node=33");
+  ASSERT_TRUE(f.pedals.has_value());
+  EXPECT_EQ(f.pedals->vacuum_max_mmhg, 650.0);
+  EXPECT_EQ(f.pedals->cut_rate_max_cpm, 10000.0);
+}
+
+TEST(RigFile, FieldsReachTheSpec) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rig-file-test-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "hand.sim") << "device tracker\nkey 0 0 0 20 0 0 0 0\n";
+  const rig::RigFile f = rig::parse_rig_file(std::string(kHead) + "name = \"bench\"\n" +
+                                                 "[[device]]\nname = \"light\"\nrole = \"tracker\"\n"
+                                                 "uri = \"sim:tracker?transport=pty\"\nid = 7\nserial = 4242\ninstrument = 1\n"
+                                                 "rate_hz = 250\nscript = \"hand.sim\"\n",
+                                             "t.toml", dir.string());
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(f.devices.size(), 1u);
+  const rig::DeviceSpec& d = f.devices[0];
+  EXPECT_EQ(f.name, "bench");
+  EXPECT_EQ(d.name, "light");
+  EXPECT_EQ(d.device_id, 7);
+  EXPECT_EQ(d.expected_serial, 4242u);
+  EXPECT_EQ(d.channel, 1);
+  EXPECT_EQ(d.sample_rate_hz, 250);
+  EXPECT_EQ(d.sim_script, "device tracker\nkey 0 0 0 20 0 0 0 0\n") << "read relative to the rig file";
+  EXPECT_EQ(d.uri, "sim:tracker?transport=pty") << "canonical";
+  EXPECT_FALSE(f.pedals.has_value());
+}
+
+TEST(RigFile, BadFilesAreRefusedWithFileLineAndKey) {
+  EXPECT_NE(error_of("[rig]\nversion = 2\n").find("t.toml:2: rig.version: this is a version 2 rig file; this vitreo reads version 1"),
+            std::string::npos);
+  EXPECT_NE(error_of("[rig]\nname = \"x\"\n").find("rig.version missing"), std::string::npos);
+  EXPECT_NE(error_of(kHead).find("no [[device]] entries"), std::string::npos);
+  EXPECT_NE(error_of("devices = 1\n" + std::string(kHead)).find("t.toml:1: devices: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "colour = \"red\"\n").find("t.toml:8: device[0].colour: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[[device]]\nname = \"tracker\"\n").find("device[1].name: 'tracker' names two devices"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + kTracker).find("device[1].id: 1 is the id of two devices"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"a b\"\n").find("letters, digits"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"t\"\nrole = \"camera\"\n").find("t.toml:5: device[0].role: 'camera'"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"t\"\nrole = \"tracker\"\nuri = \"usb:7a11\"\n")
+                .find("t.toml:6: device[0].uri: device URI 'usb:7a11'"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"t\"\nrole = \"tracker\"\nid = 1\n").find("no uri"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"t\"\nrole = \"tracker\"\nuri = \"can:can0?node=5\"\n")
+                .find("no id"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "id = 0\n").find("id"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"p\"\nrole = \"pedals\"\nuri = \"serial:/dev/x\"\nid = 1\ninstrument = 0\n")
+                .find("only trackers carry an instrument"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"p\"\nrole = \"pedals\"\nuri = \"sim:tracker?transport=pty\"\nid = 1\n")
+                .find("simulates another kind of device than its role, pedals"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "script = \"x.sim\"\n").find("only simulated devices"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "[[device]]\nname = \"t\"\nrole = \"tracker\"\nuri = \"sim:tracker\"\nid = 1\nscript = \"none.sim\"\n")
+                .find("none.sim: cannot read the device's script"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[[device]]\nname = \"u\"\nrole = \"tracker\"\nuri = \"usb:1209:7A11\"\nid = 2\n")
+                .find("'usb:1209:7a11' is given for two devices"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[pedals]\nvacuum_axis = 9\n").find("pedals.vacuum_axis"), std::string::npos);
+}
