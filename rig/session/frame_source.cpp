@@ -301,7 +301,7 @@ void capture_progress(SimulationModel& model, ViewSnapshot& out) {
   o.retina_tears = totals.retina_tears;
   for (std::size_t k = 0; k < OverlaySnapshot::kMaxEventKinds; ++k) o.event_counts[k] = k < totals.events.size() ? totals.events[k] : 0;
   o.retina_force_un = 0.0;
-  const core::InstrumentSystem& sys = model.simulation();
+  const core::Simulation& sys = model.simulation();
   for (std::uint32_t i = 0; i < sys.instrument_count(); ++i) o.retina_force_un = std::max(o.retina_force_un, sys.instrument(i).retina_force_un);
 }
 
@@ -347,7 +347,7 @@ bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSn
   }
   // Instruments as the simulation placed them (eye frame, after the eye's rotation), with their
   // handles and what the pedals make them do.
-  const core::InstrumentSystem& sys = model.simulation();
+  const core::Simulation& sys = model.simulation();
   const SurgicalControls& controls = model.controls();
   constexpr std::uint32_t kSlots = sizeof(out.instruments) / sizeof(out.instruments[0]);
   for (std::uint32_t i = 0; i < kSlots; ++i) {
@@ -371,7 +371,7 @@ bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSn
                             d.pick_radius_mm, d.blade_length_mm, d.sideways_blade_mm, d.vitrector_port_setback_mm};
     for (int k = 0; k < 8; ++k) o.dims[k] = static_cast<float>(dims[k]);
     o.cutting = st.description.kind == core::InstrumentKind::kVitrector && st.input.pedal > 0.0;
-    o.cut_rate_hz = static_cast<float>(controls.cut_rate_cpm > 0.0 ? controls.cut_rate_cpm / 60.0 : sys.options().vitrector_cut_rate_hz);
+    o.cut_rate_hz = static_cast<float>(controls.cut_rate_cpm > 0.0 ? controls.cut_rate_cpm / 60.0 : sys.options().vitrector.cut_rate_cpm / 60.0);
     o.aim_hit = st.description.kind == core::InstrumentKind::kEndolaser && st.inside && st.aim_hit;
     o.firing = st.description.kind == core::InstrumentKind::kEndolaser && st.input.trigger;
   }

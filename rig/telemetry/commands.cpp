@@ -107,7 +107,7 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
   } else if (word == "z" || word == "zoom" || word == "focus") {
     char* end = nullptr;
     const double v = arg.empty() ? 0.0 : std::strtod(arg.c_str(), &end);
-    if (arg.empty() || end == arg.c_str() || *end != '\0' || !std::isfinite(v)) {
+    if (arg.empty() || end != arg.c_str() + arg.size() || !std::isfinite(v)) {  // the whole argument, NULs included
       out.error = word == "focus" ? "focus needs a finite number (mm), e.g. 'focus 0.8'" : "zoom needs a finite number, e.g. 'zoom 12.5'";
     } else {
       c.command = static_cast<std::int8_t>(word == "focus" ? CommandCode::Focus : CommandCode::Zoom);
@@ -121,7 +121,7 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
     const char* rest = end;
     char* end_y = nullptr;
     const double y = arg.empty() ? 0.0 : std::strtod(rest, &end_y);
-    if (arg.empty() || end == arg.c_str() || end_y == rest || *end_y != '\0') {
+    if (arg.empty() || end == arg.c_str() || end_y == rest || end_y != arg.c_str() + arg.size()) {
       out.error = "pan needs two numbers (mm from the region of interest), e.g. 'pan 1.5 -2'";
     } else {
       c.command = static_cast<std::int8_t>(CommandCode::Pan);

@@ -693,7 +693,7 @@ TEST(Instruments, ABladeAt5mmPerSecondCutsOneSlitAndLeavingTheEyeEndsIt) {
   TopologyAdapter topology(world, {m}, {});
   InstrumentSceneOptions o;
   o.ports_mm = {Vec3(0, 0, 10)};
-  InstrumentSystem sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
+  Simulation sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
   sys.set_topology(&topology);
   auto at = [&](double x, double z) {
     InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z);
@@ -748,7 +748,7 @@ TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
     TopologyAdapter topology(world, {m}, {});
     InstrumentSceneOptions o;
     o.ports_mm = {Vec3(0, 0, 10)};
-    InstrumentSystem sys(world, o, {{InstrumentKind::kScissors, Gauge::k23, 0, {}}});
+    Simulation sys(world, o, {{InstrumentKind::kScissors, Gauge::k23, 0, {}}});
     sys.set_topology(&topology);
     // The hinge 0.3 mm above the membrane (the tip is a jaw length below it), jaws open in the
     // x–z plane: each jaw pierces it 0.3 · tan 25° = 0.14 mm from under the hinge.

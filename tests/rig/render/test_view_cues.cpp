@@ -150,7 +150,7 @@ TEST_F(ViewCues, LaserBurnsWhitenOverAFewHundredMilliseconds) {
     // A fresh renderer each time: the burn is painted as white as its age (it only ever whitens).
     vr::StereoRenderer r(vr::RenderSettings{kW, kH, 512, 512});
     vr::FrameScene s = base_scene();
-    find(s, vt::kRetina)->burns.push_back({hit, {}, 0.5f, age});
+    find(s, vt::kRetina)->burns.push_back({hit, {}, 0.5f, {}, age});
     vr::StereoFrame f;
     r.render(s, f);
     const double l = vt::patch(f.eye(0), vt::project_to_pixel(s, 0, hit, kW, kH), 1).luma();
@@ -166,7 +166,7 @@ TEST_F(ViewCues, LaserBurnsWhitenOverAFewHundredMilliseconds) {
   EXPECT_GT(at_end, unburnt + 40.0) << "white after a few hundred milliseconds";
   // One renderer watching the same burn age: it whitens across frames.
   vr::FrameScene s = base_scene();
-  find(s, vt::kRetina)->burns.push_back({hit, {}, 0.5f, 0.02f});
+  find(s, vt::kRetina)->burns.push_back({hit, {}, 0.5f, {}, 0.02f});
   const double early = vt::patch(render(s).eye(0), vt::project_to_pixel(s, 0, hit, kW, kH), 1).luma();
   find(s, vt::kRetina)->burns.back().age_s = 0.5f;
   const double late = vt::patch(render(s).eye(0), vt::project_to_pixel(s, 0, hit, kW, kH), 1).luma();
