@@ -121,8 +121,8 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
     const char* rest = end;
     char* end_y = nullptr;
     const double y = arg.empty() ? 0.0 : std::strtod(rest, &end_y);
-    if (arg.empty() || end == arg.c_str() || end_y == rest || end_y != arg.c_str() + arg.size()) {
-      out.error = "pan needs two numbers (mm from the region of interest), e.g. 'pan 1.5 -2'";
+    if (arg.empty() || end == arg.c_str() || end_y == rest || end_y != arg.c_str() + arg.size() || !std::isfinite(x) || !std::isfinite(y)) {
+      out.error = "pan needs two finite numbers (mm from the region of interest), e.g. 'pan 1.5 -2'";
     } else {
       c.command = static_cast<std::int8_t>(CommandCode::Pan);
       c.value = x;

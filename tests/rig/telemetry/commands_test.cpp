@@ -239,7 +239,7 @@ TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
   for (const char* bad : {"", "   ", "zoom", "zoom x", "zoom 3x", "save", "n 3", "fly",
                           "s aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa", "s ../x", "s .hidden",
                           "zoom nan", "zoom inf", "z -inf", "zoom 1e999", "pan", "pan 1", "pan 1 x",
-                          "pan 1 2 3", "focus", "focus far", "wide 2", "focus nan"}) {
+                          "pan 1 2 3", "focus", "focus far", "wide 2", "focus nan", "pan 1e999 0", "pan 0 -1e999"}) {
     const ParsedCommand p = parse_command_line(bad, "terminal", 1);
     EXPECT_FALSE(p.ok) << "'" << bad << "' parsed";
     EXPECT_FALSE(p.error.empty());
