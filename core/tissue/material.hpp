@@ -41,8 +41,8 @@ struct TissueMaterial {
 
   // Internal (viscoelastic) damping of the springs, as a time constant: each spring carries a
   // dashpot of coefficient τ·k in parallel (stiffness-proportional Rayleigh damping). Soft tissue is
-  // strongly viscous; without this a light membrane rings after every release. Applied through
-  // XPBD's damped constraint update (Macklin et al. 2016, eq. 26).
+  // strongly viscous; without this a light membrane rings after every release. Applied implicitly in
+  // each vertex's Newton step as ½ (τ k / h) (n · Δd)² over the substep (stage_solve.cpp).
   double internal_damping_s = 0.01;
 
   // Added mass: a sheet this thin cannot move without moving the fluid around it, and that fluid
