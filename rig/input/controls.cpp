@@ -101,8 +101,10 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
     if (it == fields.end()) throw std::runtime_error(where + ": unknown key");
     const Field& f = it->second;
     double value;
-    if (auto i = node.value<std::int64_t>(); i && node.is_integer()) {
-      value = static_cast<double>(*i);
+    // is_integer() first: toml++ converts a float node to an integer by a plain cast, undefined
+    // behaviour for one out of range (found by the pedal-config fuzzer).
+    if (node.is_integer()) {
+      value = static_cast<double>(*node.value<std::int64_t>());
     } else if (auto d = node.value<double>(); d && f.real) {
       value = *d;
     } else {

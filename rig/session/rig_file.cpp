@@ -56,8 +56,9 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
   for (const auto& [k, v] : *rig) {
     const std::string key = "rig." + std::string(k.str());
     if (k == "version") {
+      // is_integer() before value<>(): toml++ casts a float to an integer without a range check.
+      if (!v.is_integer()) fail(v, key, "must be an integer");
       const auto version = v.value<std::int64_t>();
-      if (!v.is_integer() || !version) fail(v, key, "must be an integer");
       if (*version != kRigFileVersion) {
         fail(v, key, "this is a version " + std::to_string(*version) + " rig file; this vitreo reads version " +
                          std::to_string(kRigFileVersion));
@@ -85,8 +86,9 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
     bool have_name = false, have_role = false, have_uri = false, have_id = false, have_instrument = false;
     std::string script_file;
     auto integer = [&](const toml::node& v, const std::string& key, std::int64_t lo, std::int64_t hi) {
+      if (!v.is_integer()) fail(v, key, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
       const auto n = v.value<std::int64_t>();
-      if (!v.is_integer() || !n || *n < lo || *n > hi) {
+      if (!n || *n < lo || *n > hi) {
         fail(v, key, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
       }
       return *n;
