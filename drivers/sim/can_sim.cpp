@@ -58,7 +58,7 @@ void CanSimDevice::step(std::uint64_t now_us) {
     if (fd_) {
       proto::CanFrame fr{vp_can_id(vp_can_default_priority(type), type, node_), true, p};
       fr.data.resize(vp_canfd_round_len(p.size()), 0);
-      written_ += sock_.write(fr);
+      if (sock_.write(fr)) ++written_, bytes_written_ += fr.data.size();
     } else {
       // classic: segment the packet bytes as vp_can_segment does (tail bytes, CRC for multi-frame)
       const std::uint32_t cid = vp_can_id(vp_can_default_priority(type), type, node_);
@@ -77,7 +77,7 @@ void CanSimDevice::step(std::uint64_t now_us) {
         if (off == 0) tail |= VP_CAN_TAIL_SOT;
         if (off + n == s.size()) tail |= VP_CAN_TAIL_EOT;
         fr.data.push_back(tail);
-        written_ += sock_.write(fr);
+        if (sock_.write(fr)) ++written_, bytes_written_ += fr.data.size();
         toggle ^= VP_CAN_TAIL_TOGGLE;
       }
     }

@@ -22,6 +22,7 @@ class CanSimDevice final : public SimulatedPeer {
   bool plugged() const { return !manual_unplug_ && !scripted_down_; }
   FirmwareEmulator& emulator() override { return emu_; }
   std::uint64_t frames_written() const { return written_; }
+  std::uint64_t bytes_sent() const override { return bytes_written_; }
 
  private:
   FirmwareEmulator emu_;
@@ -32,6 +33,7 @@ class CanSimDevice final : public SimulatedPeer {
   std::uint8_t tid_[256] = {};
   std::string error_;
   std::uint64_t written_ = 0;
+  std::uint64_t bytes_written_ = 0;  // payload bytes of the frames written
   bool manual_unplug_ = false, scripted_down_ = false;
 };
 

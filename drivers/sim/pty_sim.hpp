@@ -30,6 +30,7 @@ class PtySimDevice final : public SimulatedPeer {
   FirmwareEmulator& emulator() override { return emu_; }
   std::uint64_t tx_overflows() const { return tx_overflows_; }
   std::uint64_t bytes_written() const { return bytes_written_; }
+  std::uint64_t bytes_sent() const override { return bytes_written_; }
 
  private:
   void open_pty();

@@ -21,6 +21,11 @@ class SimulatedPeer {
   virtual void unplug() = 0;
   virtual void plug() = 0;
   virtual FirmwareEmulator& emulator() = 0;
+  // Bytes handed to the host side of the transport so far, in the unit the host's driver counts
+  // them (LinkStats::bytes: serial bytes, CAN frame payloads, USB report bytes). A lockstep session
+  // (rig/session/device_hub.hpp) waits until the driver has counted as many: then every sample the
+  // emulator made for the step has arrived, however the kernel delayed it.
+  virtual std::uint64_t bytes_sent() const = 0;
 };
 
 }  // namespace vitreo::drivers::sim

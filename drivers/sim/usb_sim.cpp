@@ -40,6 +40,7 @@ struct UsbSimDevice::Impl {
   std::deque<proto::Bytes> reports;
   std::deque<Urb> pending_in, done;
   std::uint64_t dropped = 0, handled = 0;
+  std::uint64_t bytes_delivered = 0;  // report bytes copied into the host's URBs
   proto::Bytes host_rx;
 
   static gboolean on_ioctl(UMockdevIoctlBase*, UMockdevIoctlClient* client, gpointer self) {
@@ -173,6 +174,7 @@ struct UsbSimDevice::Impl {
       std::memcpy(urb.buf->data, r.data(), n);
       u->actual_length = static_cast<int>(n);
       u->status = 0;
+      bytes_delivered += n;
       done.push_back(urb);
       reports.pop_front();
     }
@@ -332,6 +334,11 @@ std::uint64_t UsbSimDevice::reports_dropped() const {
 std::uint64_t UsbSimDevice::urbs_handled() const {
   std::lock_guard<std::mutex> l(impl_->m);
   return impl_->handled;
+}
+
+std::uint64_t UsbSimDevice::bytes_sent() const {
+  std::lock_guard<std::mutex> l(impl_->m);
+  return impl_->bytes_delivered;
 }
 
 }  // namespace vitreo::drivers::sim

@@ -37,6 +37,7 @@ class UsbSimDevice final : public SimulatedPeer {
   FirmwareEmulator& emulator() override { return emu_; }
   std::uint64_t reports_dropped() const;
   std::uint64_t urbs_handled() const;
+  std::uint64_t bytes_sent() const override;
 
   struct Impl;
 

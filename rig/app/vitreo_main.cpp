@@ -171,6 +171,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> serial_devices;
   std::vector<std::string> sim_unplugs;
   bool realtime = false;
+  bool lockstep = false, unpaced = false;
   bool verify_replay = true;
   bool render = true;
   bool commands_from_stdin = false;
@@ -216,6 +217,11 @@ int main(int argc, char** argv) {
                      "3 a different final state, 4 truncated, 5 corrupted (replayed up to there), 1 unreadable")
           ->check(CLI::ExistingFile);
   auto* realtime_opt = app.add_flag("--realtime", realtime, "ask for SCHED_FIFO, locked memory and a dedicated core for physics");
+  auto* lockstep_opt = app.add_flag("--lockstep", lockstep,
+               "simulated devices on the simulation's clock: each step waits for its inputs, so a scripted session\n"
+               "receives the same samples at the same steps however loaded the machine is");
+  app.add_flag("--unpaced", unpaced, "with --lockstep: run as fast as the machine goes instead of at real time")
+      ->needs(lockstep_opt);
   app.add_flag("!--no-verify", verify_replay, "do not replay the recording at the end");
   app.add_flag("!--no-render", render, "no stereo frames (EGL) at all");
   auto* stdin_opt = app.add_flag("--commands-from-stdin", commands_from_stdin,
@@ -309,6 +315,8 @@ int main(int argc, char** argv) {
     config.record_path = (out / "session.lcmlog").string();
     config.snapshot_dir = out.string();
     config.realtime = realtime;
+    config.device_mode = lockstep ? vitreo::rig::HubMode::lockstep : vitreo::rig::HubMode::realtime;
+    config.unpaced = unpaced;
     config.render = render;
     if (commands_from_stdin || ::isatty(STDIN_FILENO)) {
       config.command_fd = STDIN_FILENO;
@@ -422,6 +430,7 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(s.inputs_applied), static_cast<unsigned long long>(s.inputs_refused),
                 static_cast<unsigned long long>(s.inputs_recorded), static_cast<unsigned long long>(s.recorder_dropped));
     for (const auto& line : s.device_lines) std::printf("  device           %s\n", line.c_str());
+    if (!s.lockstep_line.empty()) std::printf("  lockstep         %s\n", s.lockstep_line.c_str());
     for (const auto& line : s.fault_lines) std::printf("  sensor faults    %s\n", line.c_str());
     std::printf("  events           %llu grasps, %llu burns, %llu attachments broken, %llu tears, %llu instrument events, "
                 "%llu steps rolled back\n",

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -16,7 +17,8 @@
 
 namespace vitreo::rig {
 
-DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* status_out) : status_out_(status_out) {
+DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* status_out, HubMode mode)
+    : status_out_(status_out), mode_(mode), clock_(mode) {
   for (auto& spec : specs) {
     auto d = std::make_unique<Device>();
     d->spec = spec;
@@ -32,6 +34,8 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
     std::string error;
     d->driver = drivers::open_device(spec.uri, clock_, options, &error);
     if (!d->driver) throw std::runtime_error("device " + spec.name + ": " + error);
+    if (mode_ == HubMode::lockstep && !d->driver->simulated_peer())
+      throw std::runtime_error("device " + spec.name + " (" + spec.uri + "): a lockstep session needs simulated devices (sim:...); a real device runs on its own clock");
     Device* raw = d.get();
     // A link change as a recorded input: values[0] the LinkInput, values[1] the device's type (from
     // its DEVICE_INFO, 0 before one came) — only a tracker's link freezes an instrument.
@@ -79,12 +83,23 @@ DeviceHub::~DeviceHub() { stop(); }
 
 void DeviceHub::start() {
   if (running_.exchange(true)) return;
+  if (mode_ == HubMode::lockstep) {
+    sim_thread_ = std::thread([this] { run_lockstep_sims(); });
+    driver_thread_ = std::thread([this] { run_lockstep_drivers(); });
+    return;
+  }
   sim_thread_ = std::thread([this] { run_sims(); });
   driver_thread_ = std::thread([this] { run_drivers(); });
 }
 
 void DeviceHub::stop() {
   if (!running_.exchange(false)) return;
+  if (mode_ == HubMode::lockstep) {  // wake the two threads from their waits: they see !running_
+    grant_.fetch_add(1, std::memory_order_acq_rel);
+    grant_.notify_all();
+    emulated_.fetch_add(1, std::memory_order_acq_rel);
+    emulated_.notify_all();
+  }
   if (sim_thread_.joinable()) sim_thread_.join();
   if (driver_thread_.joinable()) driver_thread_.join();
 }
@@ -92,21 +107,131 @@ void DeviceHub::stop() {
 void DeviceHub::unplug(std::size_t device) { devices_.at(device)->plug_request.store(-1); }
 void DeviceHub::plug(std::size_t device) { devices_.at(device)->plug_request.store(+1); }
 
+void DeviceHub::step_peers(std::uint64_t now) {
+  for (auto& d : devices_) {
+    drivers::sim::SimulatedPeer* peer = d->driver->simulated_peer();
+    if (!peer) continue;
+    const int request = d->plug_request.exchange(0);
+    if (request < 0) peer->unplug();
+    if (request > 0) peer->plug();
+    peer->step(now);
+  }
+}
+
 void DeviceHub::run_sims() {
   // The emulators stand in for the devices' own firmware: they run on their own thread, in real
   // time, and the drivers know nothing about them beyond the bytes on their transport.
   while (running_.load(std::memory_order_acquire)) {
-    const std::uint64_t now = clock_.now_us();
-    for (auto& d : devices_) {
-      drivers::sim::SimulatedPeer* peer = d->driver->simulated_peer();
-      if (!peer) continue;
-      const int request = d->plug_request.exchange(0);
-      if (request < 0) peer->unplug();
-      if (request > 0) peer->plug();
-      peer->step(now);
-    }
+    step_peers(clock_.now_us());
     std::this_thread::sleep_for(std::chrono::microseconds(250));
   }
+}
+
+void DeviceHub::run_lockstep_sims() {
+  // One pass per grant, at the granted time: the emulators read what the host sent since the last
+  // round, answer it, and write every frame due by now.
+  std::uint64_t done = 0;
+  for (;;) {
+    grant_.wait(done, std::memory_order_acquire);
+    if (!running_.load(std::memory_order_acquire)) return;
+    const std::uint64_t g = grant_.load(std::memory_order_acquire);
+    step_peers(clock_.now_us());
+    done = g;
+    emulated_.store(g, std::memory_order_release);
+    emulated_.notify_one();
+  }
+}
+
+void DeviceHub::run_lockstep_drivers() {
+  // After the emulators' pass, read until each driver has counted every byte its peer wrote: a pty
+  // hands bytes on through a kernel work queue, so "nothing to read yet" does not mean "all read".
+  std::uint64_t done = 0;
+  std::uint64_t next_status = 0;
+  // Each driver opens its port first: a serial driver flushes what was written before it opened,
+  // so the emulators' first words must come after.
+  for (auto& d : devices_) d->driver->poll(0);
+  drivers_opened_.store(true, std::memory_order_release);
+  drivers_opened_.notify_one();
+  for (;;) {
+    emulated_.wait(done, std::memory_order_acquire);
+    if (!running_.load(std::memory_order_acquire)) return;
+    const std::uint64_t g = emulated_.load(std::memory_order_acquire);
+    const auto started = std::chrono::steady_clock::now();
+    bool changed = false;
+    for (;;) {
+      bool all_in = true;
+      for (auto& d : devices_) {
+        d->driver->poll(0);
+        const std::uint64_t sent = d->driver->simulated_peer()->bytes_sent();
+        if (d->driver->session().stats().bytes + d->bytes_unaccounted < sent) all_in = false;
+      }
+      if (all_in) break;
+      if (std::chrono::steady_clock::now() - started > std::chrono::microseconds(kStallWallUs)) {
+        // Bytes that will not come (a link closed or flushed with them in flight): say so, stop
+        // waiting for them, and go on.
+        for (auto& d : devices_) {
+          const std::uint64_t sent = d->driver->simulated_peer()->bytes_sent();
+          const std::uint64_t got = d->driver->session().stats().bytes + d->bytes_unaccounted;
+          if (got >= sent) continue;
+          spdlog::warn("device {}: lockstep: {} bytes written by its emulator never reached the driver (link {}); going on without them",
+                       d->spec.name, sent - got, drivers::to_string(d->driver->session().state()));
+          d->bytes_unaccounted += sent - got;
+        }
+        stalls_.fetch_add(1, std::memory_order_relaxed);
+        break;
+      }
+      std::this_thread::yield();
+    }
+    for (auto& d : devices_) changed = changed || d->driver->session().state() != d->last_state;
+    const std::uint64_t now = clock_.now_us();
+    if (now >= next_status || changed) {  // 10 Hz of simulated time
+      publish_status(now);
+      next_status = now + 100'000;
+    }
+    done = g;
+    delivered_.store(g, std::memory_order_release);
+    delivered_.notify_one();
+  }
+}
+
+std::uint64_t DeviceHub::grant_round() {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::uint64_t g = grant_.fetch_add(1, std::memory_order_acq_rel) + 1;
+  grant_.notify_one();
+  for (std::uint64_t seen = delivered_.load(std::memory_order_acquire); seen != g && running_.load(std::memory_order_acquire);
+       seen = delivered_.load(std::memory_order_acquire)) {
+    delivered_.wait(seen, std::memory_order_acquire);
+  }
+  const auto waited = static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count());
+  lock_stats_.wait_ns_total += waited;
+  lock_stats_.wait_ns_max = std::max(lock_stats_.wait_ns_max, waited);
+  lock_stats_.stalls = stalls_.load(std::memory_order_relaxed);
+  return g;
+}
+
+void DeviceHub::lockstep_connect(double wall_timeout_s) {
+  if (mode_ != HubMode::lockstep) return;
+  clock_.sim_us.store(HubClock::kStartUs, std::memory_order_release);
+  drivers_opened_.wait(false, std::memory_order_acquire);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wall_timeout_s);
+  for (;;) {
+    grant_round();
+    ++lock_stats_.handshake_rounds;
+    std::string missing;
+    for (const auto& d : devices_) {
+      if (d->driver->session().state() != drivers::LinkState::streaming) missing += (missing.empty() ? "" : ", ") + d->spec.name;
+    }
+    if (missing.empty()) return;
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error("lockstep: " + missing + " did not start streaming within " + std::to_string(wall_timeout_s) + " s");
+  }
+}
+
+void DeviceHub::lockstep_deliver(std::uint64_t step, std::uint64_t period_us) {
+  if (mode_ != HubMode::lockstep) return;
+  clock_.sim_us.store(HubClock::kStartUs + step * period_us, std::memory_order_release);
+  grant_round();
+  ++lock_stats_.grants;
 }
 
 void DeviceHub::run_drivers() {

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -226,8 +227,11 @@ SessionSummary run_session(const SessionConfig& config) {
 
   std::vector<DeviceSpec> devices = config.devices;
   if (config.adapt_devices) config.adapt_devices(model.current_case(), devices);
-  DeviceHub hub(devices, &devices_out);
+  DeviceHub hub(devices, &devices_out, config.device_mode);
+  const bool lockstep = config.device_mode == HubMode::lockstep;
+  const auto period_us = static_cast<std::uint64_t>(std::llround(config.model.dt_s * 1e6));
   runtime::SteadyClock wall;
+  runtime::SimulatedClock unpaced_clock;  // lockstep without pacing: the loop never sleeps
   runtime::HarnessConfig harness_config;
   harness_config.loop.period_ns = static_cast<std::int64_t>(config.model.dt_s * 1e9);
   harness_config.max_steps = config.steps;
@@ -240,7 +244,8 @@ SessionSummary run_session(const SessionConfig& config) {
   std::size_t switches = 0;
 
   int stopped_by = 0;                              // the signal that ended the session early (physics thread)
-  runtime::ThreadHarness harness(wall, harness_config, [&](std::uint64_t k, double t_s) {
+  runtime::Clock& physics_clock = lockstep && config.unpaced ? static_cast<runtime::Clock&>(unpaced_clock) : static_cast<runtime::Clock&>(wall);
+  runtime::ThreadHarness harness(physics_clock, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
     // A stop request (SIGINT/SIGTERM) makes this step the session's last: it is finished, the end
     // marker recorded, and nothing is cut off in the middle.
@@ -285,6 +290,7 @@ SessionSummary run_session(const SessionConfig& config) {
       }
       commands.report(cmd, why, ctx);
     }
+    hub.lockstep_deliver(k, period_us);  // lockstep: step k's inputs, all of them, before taking them
     hub.take_new(consume);
     if (last) consume(session_end_marker(k + 1));
     const core::StepReport report = model.step();
@@ -359,6 +365,7 @@ SessionSummary run_session(const SessionConfig& config) {
   if (config.command_fd >= 0) terminal = std::make_unique<telemetry::TerminalCommands>(config.command_fd, commands, config.command_echo);
 
   hub.start();
+  if (lockstep) hub.lockstep_connect();
   harness.start();
   if (terminal) terminal->start();
   harness.wait_physics();
@@ -411,6 +418,16 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.telemetry_published = publisher.published();
   summary.telemetry_dropped = publisher.dropped();
   summary.state_hash = model.state_hash();
+  if (lockstep) {
+    const LockstepStats ls = hub.lockstep_stats();
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "%llu steps granted after %llu handshake rounds; physics waited %.1f us a step on average (max %.1f ms); %llu stalls",
+                  static_cast<unsigned long long>(ls.grants), static_cast<unsigned long long>(ls.handshake_rounds),
+                  ls.grants ? static_cast<double>(ls.wait_ns_total) * 1e-3 / static_cast<double>(ls.grants) : 0.0,
+                  static_cast<double>(ls.wait_ns_max) * 1e-6, static_cast<unsigned long long>(ls.stalls));
+    summary.lockstep_line = line;
+  }
   if (recorder) {
     // The end event: the recording is complete, and says which state a replay must reach.
     if (!recorder->finish(telemetry::RecordingEnd{static_cast<std::int64_t>(summary.steps), summary.state_hash, summary.stop_reason}))

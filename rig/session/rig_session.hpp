@@ -35,6 +35,13 @@ struct SessionConfig {
   int command_fd = -1;
   std::FILE* command_echo = stdout;
   bool realtime = false;    // SCHED_FIFO/mlockall/affinity for physics where permitted
+  // Lockstep (DeviceHub, HubMode::lockstep): every device simulated, the emulators on the
+  // simulation's clock, each step's inputs waited for, so a scripted session receives the same
+  // samples at the same steps however loaded the machine is. Real time: the rig's way.
+  HubMode device_mode = HubMode::realtime;
+  // Lockstep only: run physics as fast as it goes (no wall-clock pacing), for tests and batch
+  // scoring; false paces it to real time where the machine keeps up (a demonstration).
+  bool unpaced = false;
   // Scripted actions at given steps, run on the physics thread (hardware-in-the-loop tests pull a
   // simulated cable with it). Must be quick and wait-free, like everything on that thread.
   std::function<void(std::uint64_t step, DeviceHub& hub)> on_step;
@@ -88,6 +95,8 @@ struct SessionSummary {
   // The final score of the case the session ended in (core/metrics), as published on VITREO_SCORE,
   // and its criteria ("membrane_removed epiretinal: 0.42 of 0.9"), one line each.
   std::vector<std::string> score_lines;
+  // Lockstep sessions: grants, handshake rounds, stalls and physics' wait for its inputs.
+  std::string lockstep_line;
 };
 
 // Runs a live session to completion (config.steps) and returns its summary. Throws on setup errors
