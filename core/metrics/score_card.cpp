@@ -87,7 +87,9 @@ void compute_scores(const SessionTotals& t, const std::vector<CriterionProgress>
       o.per_light_too_close * t.count(InstrumentEventKind::kLightTooClose) +
       o.per_burn_on_detached * t.count(InstrumentEventKind::kLaserOnDetachedRetina) +
       o.per_burn_off_target * t.burns_elsewhere;
-  card.categories.push_back({"tissue_treatment", bounded(100.0 * std::exp(-damage)), o.weight_tissue});
+  // Care is earned by doing the work: the quality categories count in proportion to the progress
+  // made, so a hand that never enters the eye scores no care (an idle run scored 77 before).
+  card.categories.push_back({"tissue_treatment", bounded(100.0 * progress * std::exp(-damage)), o.weight_tissue});
 
   // Instrument handling: clumsiness as e-folds, and (with a light pipe) how much of the work was lit.
   const double clumsy = o.per_instrument_collision * t.count(InstrumentEventKind::kInstrumentCollision) +
@@ -98,7 +100,7 @@ void compute_scores(const SessionTotals& t, const std::vector<CriterionProgress>
     const double lit = std::clamp(t.lit_working_time_s / t.working_time_s, 0.0, 1.0);
     handling *= (1.0 - o.illumination_share) + o.illumination_share * lit;
   }
-  card.categories.push_back({"instrument_handling", bounded(100.0 * handling), o.weight_instrument});
+  card.categories.push_back({"instrument_handling", bounded(100.0 * progress * handling), o.weight_instrument});
 
   double sum = 0.0, weights = 0.0;
   for (const auto& c : card.categories) {

@@ -12,6 +12,7 @@ void MetricsOptions::validate() const {
   require_range(contact_force_un, 0.0, 1e6, "metrics: contact_force_un");
   require_range(retina_force_limit_un, -1e12, 1e12, "metrics: retina_force_limit_un");
   require_range(laser_target_band_mm, 0.0, 10.0, "metrics: laser_target_band_mm");
+  require_range(odometer_stride_mm, 0.0, 1.0, "metrics: odometer_stride_mm");
   progress.validate();
   scores.validate();
 }
@@ -77,13 +78,19 @@ Status SessionMetrics::observe(double dt) {
   for (std::uint32_t i = 0; i < per_instrument_.size(); ++i) {
     const InstrumentState& st = sim_->instrument(i);
     InstrumentMetrics& m = per_instrument_[i];
-    // Odometer: only the path between two steps the tip spent inside the eye.
+    // Odometer: only the path while the tip is inside the eye, counted in strides of at least
+    // odometer_stride_mm from the last counted point — a tracker's jitter (5 µm at 1 kHz) would
+    // otherwise add 5 mm a second to a hand held still; a real motion loses under a stride.
     if (st.inside && was_inside_[i]) {
       const double d = (st.frame.tip - last_tip_[i]).norm();
-      m.path_length_mm += d;
-      totals_.path_length_mm += d;
+      if (d >= options_.odometer_stride_mm) {
+        m.path_length_mm += d;
+        totals_.path_length_mm += d;
+        last_tip_[i] = st.frame.tip;
+      }
+    } else {
+      last_tip_[i] = st.frame.tip;
     }
-    last_tip_[i] = st.frame.tip;
     was_inside_[i] = st.inside ? 1 : 0;
 
     const double f = st.retina_force_un;

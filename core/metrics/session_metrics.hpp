@@ -27,6 +27,8 @@ namespace vitreo::core {
 struct MetricsOptions {
   // An instrument touches the retina while the retina's contact force on it exceeds this (µN).
   double contact_force_un = 1.0;
+  // The odometer counts the tip's path in strides of at least this (mm): above sensor jitter.
+  double odometer_stride_mm = 0.05;
   // Force above which the retina is damaged (µN); ≤ 0: the instruments' retina_force_limit_un.
   double retina_force_limit_un = 0.0;
   // A burn counts as on target within this distance (along the wall) of a laser-ring guide.

@@ -609,6 +609,7 @@ SettleReport settle_world(TissueWorld& world, const SettleSpec& spec) {
   // to follow what still moves.
   settling.sleep_after_steps = std::min(surgery.sleep_after_steps, 20);
   world.replace_settings(settling);
+  world.set_breaking(false);
   // Speed measured as real displacement over the check interval of the fastest free vertex: most
   // of the retina lies still on the wall, so an average would call a rising detachment settled, and
   // a vertex held against the wall can carry a velocity it never travels.
@@ -645,6 +646,7 @@ SettleReport settle_world(TissueWorld& world, const SettleSpec& spec) {
     }
   }
   world.replace_settings(surgery);
+  world.set_breaking(true);
   world.reset_clock();
   return r;
 }

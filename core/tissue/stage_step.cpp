@@ -163,6 +163,7 @@ void TissueWorld::finish_sleep() {
 }
 
 void TissueWorld::break_attachments() {
+  if (!breaking_) return;
   for (std::uint32_t i = 0; i < attachments_.size(); ++i) {
     Attachment& at = attachments_[i];
     if (!at.intact) continue;
@@ -179,6 +180,7 @@ void TissueWorld::break_attachments() {
 }
 
 void TissueWorld::find_overstrained() {
+  if (!breaking_) return;
   // Measured on the final positions of the step: inside the sweep a spring's length is still
   // changing as its neighbours are projected after it. Springs among sleeping vertices do not
   // change, so only the active groups are scanned.

@@ -228,6 +228,12 @@ class TissueWorld {
   // ---- Settling (the scene builder settles a case with other settings, then starts the clock) --
   // Throws InvalidArgument for bad settings.
   void replace_settings(const SolverSettings& settings);
+  // While a case settles (core/scene settle_world), nothing breaks and nothing tears: the build
+  // starts the pathology at its rest lengths at once, and the transient of that start is not surgery
+  // (a contracting membrane snapped 56 of its attachments off before it stood still). Not part of
+  // the state: settle_world turns it back on before the start state is taken.
+  void set_breaking(bool on) { breaking_ = on; }
+  bool breaking() const { return breaking_; }
   // Step count and time back to zero (the settled start is time zero of the case).
   void reset_clock();
 
@@ -252,6 +258,7 @@ class TissueWorld {
   bool attachment_holds(std::uint32_t i) const;
   // Force the attachment carried during the last step (µN): the constraint multiplier over h².
   double attachment_force(std::uint32_t i) const { return attachments_.at(i).last_force_un; }
+  double attachment_break_force(std::uint32_t i) const { return attachments_.at(i).d.break_force_un; }
   // Events of the last step (valid until the next step).
   const std::vector<TissueEvent>& events() const { return events_; }
   std::uint64_t step_count() const { return step_count_; }
@@ -436,6 +443,7 @@ class TissueWorld {
   std::vector<std::uint32_t> crept_short_;  // vertices of springs that crept below the floor this step
   double cleanup_removed_mass_g_ = 0.0;
   std::vector<Attachment> attachments_;
+  bool breaking_ = true;  // see set_breaking()
   std::vector<LocalForce> local_forces_;
   std::vector<TissueEvent> events_;
   std::vector<TearCandidate> tear_candidates_;

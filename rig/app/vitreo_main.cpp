@@ -1,11 +1,10 @@
 // vitreo — the rig's main job.
 //
 // Without options it runs its embedded default: simulated devices (an instrument tracker, the foot
-// pedals and the eyeball fixture, as firmware emulators behind ptys) playing a scripted peel on a
-// real case from scenes/ (the epiretinal membrane over the macula: the forceps come in through
-// their port, grasp the membrane, pull it up and let go), through the real drivers, a fixed-step
-// physics thread, stereo frames, telemetry to an LCM log and a recording — then replays the
-// recording and checks it ends in the same state.
+// pedals and the eyeball fixture, as firmware emulators behind ptys) playing the expert surgical
+// script of a real case from scenes/ (scenes/scripts/low_membrane_macula.expert.toml), in lockstep,
+// through the real drivers, a fixed-step physics thread, stereo frames, telemetry to an LCM log and
+// a recording — then replays the recording and checks it ends in the same state.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 #include <fcntl.h>
@@ -26,6 +25,7 @@
 #include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/session/rig_session.hpp"
+#include "rig/session/surgical_script.hpp"
 
 #ifndef VITREO_SCENES_DIR
 #define VITREO_SCENES_DIR "scenes"
@@ -58,68 +58,10 @@ std::vector<std::string> cases_in(const std::string& dir) {
   return out;
 }
 
-std::string key(double t_ms, const Vec3& p, double actuation) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "key %.0f %.3f %.3f %.3f 0 0 0 %.2f\n", t_ms, p.x(), p.y(), p.z(), actuation);
-  return buf;
+// The case's own scripted surgeon, beside the cases: scripts/<case>.<kind>.toml.
+std::string case_script(const std::string& cases_dir, const std::string& case_file, const std::string& kind) {
+  return (fs::path(cases_dir) / "scripts" / (fs::path(case_file).stem().string() + "." + kind + ".toml")).string();
 }
-
-// The scripted hand for the first case: the tool tracker's keyframes, from where this case's tissue
-// really lies. Target: on a case with a membrane, a membrane vertex half-way out from its middle on
-// the side of the tool's port (where a surgeon starts a peel); else the case's region of interest.
-std::string tool_script(const vitreo::rig::PreparedCase& c) {
-  const vitreo::core::Scene& s = *c.scene;
-  const Vec3 port = c.tracker_ports[vitreo::rig::kToolTracker].position_mm;
-  Vec3 target = c.focus_mm;
-  bool membrane = false;
-  if (!s.membranes.empty()) {
-    const auto& surf = s.world.surface(s.membranes.front().surface);
-    Vec3 centroid = Vec3::Zero();
-    int n = 0;
-    for (std::uint32_t v = 0; v < surf.vertex_slots(); ++v) {
-      if (surf.vertex_alive(v)) centroid += surf.position(v), ++n;
-    }
-    if (n > 0) {
-      centroid /= n;
-      double radius = 0.0;
-      for (std::uint32_t v = 0; v < surf.vertex_slots(); ++v) {
-        if (surf.vertex_alive(v)) radius = std::max(radius, (surf.position(v) - centroid).norm());
-      }
-      double best = std::numeric_limits<double>::infinity();
-      for (std::uint32_t v = 0; v < surf.vertex_slots(); ++v) {
-        if (!surf.vertex_alive(v)) continue;
-        const double r = (surf.position(v) - centroid).norm();
-        if (r < 0.4 * radius || r > 0.6 * radius) continue;
-        const double d = (surf.position(v) - port).norm();
-        if (d < best) best = d, target = surf.position(v);
-      }
-      membrane = true;
-    }
-  }
-  const Vec3 inward = -target.normalized();                  // toward the globe centre
-  const Vec3 along = (target - port).normalized();           // the shaft's direction at the target
-  const Vec3 outside = port - 1.5 * along;                   // tip just out of the cannula
-  const Vec3 inside = port + 3.0 * along;
-  const Vec3 hover = target + 1.0 * inward;
-  const Vec3 touch = target + (membrane ? 0.02 : 0.3) * inward;
-  const Vec3 sideways = (port - target) - (port - target).dot(inward) * inward;
-  const Vec3 pulled = touch + 2.5 * inward + 1.0 * sideways.normalized();
-  std::string script = "device tracker\nrate_hz 1000\nserial 1001\ntool 3\ninstrument 0\nloop 0\n";
-  script += key(0, outside, 0);
-  script += key(600, inside, 0);
-  script += key(1600, hover, 0);
-  script += key(2200, touch, 0);
-  script += key(2500, touch, 1);     // close the jaws on the membrane
-  script += key(3700, pulled, 1);    // peel: up and toward the port
-  script += key(4100, pulled, 0);    // let go
-  script += key(4800, outside, 0);   // withdraw
-  return script;
-}
-
-const char* kPedalScript = "device pedals\nrate_hz 500\nserial 2001\nloop 0\nkey 0 0 0 0\nkey 5000 0 0 0\n";
-const char* kEyeballScript =
-    "device eyeball\nrate_hz 250\nserial 3001\nloop 0\n"
-    "key 0 0 0 0 0 0\nkey 4200 0 0 0 0 0\nkey 4800 2 -1 0 0 0\n";
 
 std::string lcm_file_url(const fs::path& p) { return "file://" + p.string() + "?mode=w"; }
 
@@ -168,10 +110,12 @@ int main(int argc, char** argv) {
   std::string replay_path;
   std::string pedal_config;
   std::string rig_path;
+  std::string script_path;
+  bool idle = false;
   std::vector<std::string> serial_devices;
   std::vector<std::string> sim_unplugs;
   bool realtime = false;
-  bool lockstep = false, unpaced = false;
+  bool lockstep = false, no_lockstep = false, unpaced = false;
   bool verify_replay = true;
   bool render = true;
   bool commands_from_stdin = false;
@@ -217,11 +161,17 @@ int main(int argc, char** argv) {
                      "3 a different final state, 4 truncated, 5 corrupted (replayed up to there), 1 unreadable")
           ->check(CLI::ExistingFile);
   auto* realtime_opt = app.add_flag("--realtime", realtime, "ask for SCHED_FIFO, locked memory and a dedicated core for physics");
+  auto* script_opt = app.add_option("--script", script_path,
+                 "play this surgical script (scenes/scripts/*.toml) with the simulated devices (default: the first case's\n"
+                 "expert script, scenes/scripts/CASE.expert.toml, when it has one)")
+                         ->check(CLI::ExistingFile);
+  app.add_flag("--idle", idle, "play no script: the simulated hand stays outside the eye, the pedals at rest")->excludes(script_opt);
   auto* lockstep_opt = app.add_flag("--lockstep", lockstep,
                "simulated devices on the simulation's clock: each step waits for its inputs, so a scripted session\n"
-               "receives the same samples at the same steps however loaded the machine is");
-  app.add_flag("--unpaced", unpaced, "with --lockstep: run as fast as the machine goes instead of at real time")
-      ->needs(lockstep_opt);
+               "receives the same samples at the same steps however loaded the machine is (the default when every\n"
+               "device is simulated)");
+  app.add_flag("--no-lockstep", no_lockstep, "simulated devices on the wall clock, as real ones run")->excludes(lockstep_opt);
+  app.add_flag("--unpaced", unpaced, "in lockstep: run as fast as the machine goes instead of at real time");
   app.add_flag("!--no-verify", verify_replay, "do not replay the recording at the end");
   app.add_flag("!--no-render", render, "no stereo frames (EGL) at all");
   auto* stdin_opt = app.add_flag("--commands-from-stdin", commands_from_stdin,
@@ -308,14 +258,29 @@ int main(int argc, char** argv) {
     model.load.retina_vertices = retina_vertices;
     model.load.texture_size_px = texture_px;
 
+    // The scripted surgeon the simulated devices play: --script, else the first case's expert
+    // script beside the cases, else none (the hand stays out, the pedals at rest).
+    vitreo::rig::SurgicalScript script;
+    script.kind = "idle";
+    script.duration_s = duration_s;
+    const std::string first_file = files[static_cast<std::size_t>(model.first_case)];
+    if (!script_path.empty()) {
+      script = vitreo::rig::read_surgical_script(script_path);
+    } else if (!idle) {
+      const std::string expert = case_script(fs::path(first_file).parent_path().string(), first_file, "expert");
+      std::error_code ec;
+      if (fs::exists(expert, ec)) script = vitreo::rig::read_surgical_script(expert);
+      else spdlog::warn("{} has no expert script ({}): the simulated hand stays outside the eye", first_file, expert);
+    }
+    if (script.case_name.empty()) script.case_name = fs::path(first_file).stem().string();
+    if (duration_opt->count() == 0 && !script.file.empty()) duration_s = script.duration_s;
+
     vitreo::rig::SessionConfig config;
     config.model = model;
-    config.steps = static_cast<std::uint64_t>(std::llround(duration_s / model.dt_s));
     config.lcm_url = lcm_url.empty() ? lcm_file_url(out / "telemetry.lcmlog") : lcm_url;
     config.record_path = (out / "session.lcmlog").string();
     config.snapshot_dir = out.string();
     config.realtime = realtime;
-    config.device_mode = lockstep ? vitreo::rig::HubMode::lockstep : vitreo::rig::HubMode::realtime;
     config.unpaced = unpaced;
     config.render = render;
     if (commands_from_stdin || ::isatty(STDIN_FILENO)) {
@@ -360,8 +325,21 @@ int main(int argc, char** argv) {
       devices = {{"tracker-0", DeviceRole::tracker, "sim:tracker?transport=pty", 1, 0, 0, 0, ""},
                  {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, ""},
                  {"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, 0, ""}};
+      // A script with a second hand (the light pipe) gets the second tracker.
+      for (const auto& h : script.hands) {
+        if (h.tracker == vitreo::rig::kLightPipeTracker)
+          devices.push_back({"tracker-1", DeviceRole::tracker, "sim:tracker?transport=pty", 4, vitreo::rig::kLightPipeTracker, 0, 0, ""});
+      }
     }
     config.devices = devices;
+    // Lockstep wherever every device is simulated (a scripted session's outcome must not depend on
+    // the machine's load); real devices run on their own clocks.
+    const bool all_simulated = std::all_of(devices.begin(), devices.end(), [](const auto& d) { return d.uri.rfind("sim:", 0) == 0; });
+    if (lockstep && !all_simulated) throw std::runtime_error("--lockstep needs every device simulated (sim:...)");
+    if (all_simulated && !no_lockstep) lockstep = true;
+    if (unpaced && !lockstep) throw std::runtime_error("--unpaced needs lockstep");
+    config.device_mode = lockstep ? vitreo::rig::HubMode::lockstep : vitreo::rig::HubMode::realtime;
+    config.steps = static_cast<std::uint64_t>(std::llround(duration_s / model.dt_s));
     struct Unplug {
       std::string name;
       std::uint64_t at_step, back_step;
@@ -391,18 +369,15 @@ int main(int argc, char** argv) {
         }
       };
     }
-    // Simulated devices without a script of their own play the main job's scripted session; the
-    // tool tracker's script follows the first case's anatomy (known once it is loaded).
-    config.adapt_devices = [](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& specs) {
+    // Simulated devices without a script of their own play the surgical script, resolved against the
+    // first case as loaded (its landmarks at its resolution).
+    config.adapt_devices = [&script, pedals = model.pedals](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& specs) {
+      const vitreo::rig::ResolvedScript resolved = vitreo::rig::resolve_script(script, c, pedals);
       for (auto& d : specs) {
         if (d.uri.rfind("sim:", 0) != 0 || !d.sim_script.empty()) continue;
-        switch (d.role) {
-          case DeviceRole::tracker:
-            if (d.channel == vitreo::rig::kToolTracker) d.sim_script = tool_script(c);
-            break;
-          case DeviceRole::pedals: d.sim_script = kPedalScript; break;
-          case DeviceRole::eyeball: d.sim_script = kEyeballScript; break;
-        }
+        const std::string name = d.role == DeviceRole::tracker ? "tracker-" + std::to_string(d.channel)
+                                 : d.role == DeviceRole::pedals ? "pedals" : "eyeball";
+        if (const auto it = resolved.device_scripts.find(name); it != resolved.device_scripts.end()) d.sim_script = it->second;
       }
     };
 
@@ -419,6 +394,8 @@ int main(int argc, char** argv) {
                 s.case_from_cache ? "settled start from the cache" : "settled now, cached", files.size());
     std::printf("  retina           %s vertices\n", retina_vertices > 0 ? std::to_string(retina_vertices).c_str() : "the case's");
     std::printf("  instruments      %s\n", s.instruments.c_str());
+    std::printf("  script           %s%s%s\n", script.file.empty() ? "none (idle)" : script.file.c_str(),
+                script.file.empty() ? "" : (" (" + script.kind + ")").c_str(), script.summary.empty() ? "" : (": " + script.summary).c_str());
     for (const auto& line : s.cases_loaded) std::printf("  case loaded      %s\n", line.c_str());
     std::printf("  simulated        %.3f s in %llu steps (%s)\n", s.simulated_s, static_cast<unsigned long long>(s.steps),
                 s.stop_reason == "duration reached" ? "the whole duration" : ("stopped early by " + s.stop_reason).c_str());

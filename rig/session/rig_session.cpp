@@ -152,6 +152,17 @@ std::vector<std::string> score_lines(SimulationModel& model) {
   }
   const core::SessionTotals& t = model.metrics().totals();
   std::snprintf(buf, sizeof buf, "iatrogenic events %u", static_cast<unsigned>(t.iatrogenic_events()));
+  std::string kinds;
+  using K = core::InstrumentEventKind;
+  for (K k : {K::kExcessiveRetinaForce, K::kUnintendedTear, K::kLaserOnDetachedRetina, K::kLightTooClose, K::kLightToxicity,
+              K::kInstrumentCollision, K::kLensTouch, K::kWallContact}) {
+    if (t.count(k) == 0) continue;
+    kinds += (kinds.empty() ? " (" : ", ") + std::string(core::to_string(k)) + " " + std::to_string(t.count(k));
+  }
+  lines.push_back(buf + kinds + (kinds.empty() ? "" : ")"));
+  std::snprintf(buf, sizeof buf, "handling: path %.1f mm, %u retina contacts (%.2f s), peak retina force %.0f uN, %u grasps, %u retina tears",
+                t.path_length_mm, static_cast<unsigned>(t.retina_contacts), t.retina_contact_time_s, t.peak_retina_force_un,
+                static_cast<unsigned>(t.count(K::kGrasp)), static_cast<unsigned>(t.retina_tears));
   lines.push_back(buf);
   return lines;
 }

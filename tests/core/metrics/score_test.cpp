@@ -95,10 +95,37 @@ TEST(Scores, MoreDamageLowersTissueTreatment) {
   t.events[static_cast<std::size_t>(InstrumentEventKind::kUnintendedTear)] = 1;
   t.events[static_cast<std::size_t>(InstrumentEventKind::kGrasp)] = 5;  // not harm
   EXPECT_EQ(t.iatrogenic_events(), 3u);
-  // Nothing but ordinary contact costs little; no contact at all is the full score.
+  // Nothing but ordinary contact costs little; no contact at all is the full score of the work
+  // done: care is earned in proportion to progress (half_done: P = 0.375).
   SessionTotals clean = ordinary();
   clean.peak_retina_force_un = clean.retina_force_impulse_un_s = 0.0;
-  EXPECT_DOUBLE_EQ(category(clean, "tissue_treatment"), 100.0);
+  EXPECT_DOUBLE_EQ(category(clean, "tissue_treatment"), 37.5);
+  std::vector<CriterionProgress> done = half_done();
+  done[0].progress = done[1].progress = 1.0;
+  EXPECT_DOUBLE_EQ(category(clean, "tissue_treatment", done), 100.0);
+}
+
+// A hand that does nothing earns nothing: no progress, no care, no efficiency — whatever it did not
+// damage. (Before the care categories were scaled by progress an idle run scored 77.)
+TEST(Scores, NoProgressScoresZeroInEveryCategory) {
+  SessionTotals idle;
+  idle.elapsed_s = 10.0;
+  idle.steps = 10000;
+  std::vector<CriterionProgress> none = half_done();
+  none[0].progress = none[1].progress = 0.0;
+  ScoreCard card;
+  compute_scores(idle, none, 600.0, ScoreOptions{}, card);
+  for (const auto& e : card.categories) EXPECT_EQ(e.value, 0.0) << e.name;
+  EXPECT_EQ(card.total, 0.0);
+  // Equal progress: the one with a retinal tear scores lower in tissue treatment and in total.
+  std::vector<CriterionProgress> some = half_done();
+  SessionTotals careful = ordinary(), careless = ordinary();
+  careless.retina_tears = 1;
+  ScoreCard a, b;
+  compute_scores(careful, some, 600.0, ScoreOptions{}, a);
+  compute_scores(careless, some, 600.0, ScoreOptions{}, b);
+  EXPECT_GT(a.find("tissue_treatment")->value, b.find("tissue_treatment")->value);
+  EXPECT_GT(a.total, b.total);
 }
 
 TEST(Scores, LongerPathsAndTimesLowerEfficiencyProgressRaisesIt) {

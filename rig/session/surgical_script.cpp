@@ -1,0 +1,502 @@
+#include "rig/session/surgical_script.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "rig/files/read_text_file.hpp"
+#include "rig/files/toml_guard.hpp"
+
+namespace vitreo::rig {
+namespace {
+
+using core::Vec3;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+
+// Reads one table's keys with file:line:key errors; refuses keys it was not asked for.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string origin, std::string where) : t_(t), origin_(std::move(origin)), where_(std::move(where)) {}
+
+  [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& why) const {
+    throw std::runtime_error(origin_ + ":" + std::to_string(line_of(n)) + ": " + where_ + key + ": " + why);
+  }
+  [[noreturn]] void fail_here(const std::string& key, const std::string& why) const { fail(t_, key, why); }
+
+  const toml::node* get(const std::string& key) {
+    seen_.insert(key);
+    return t_.get(key);
+  }
+  std::optional<double> number(const std::string& key, double lo, double hi) {
+    const toml::node* n = get(key);
+    if (!n) return std::nullopt;
+    double v;
+    if (n->is_integer()) v = static_cast<double>(n->as_integer()->get());  // is_integer() first: toml++ casts floats unchecked
+    else if (n->is_floating_point()) v = n->as_floating_point()->get();
+    else fail(*n, key, "must be a number");
+    if (!std::isfinite(v) || v < lo || v > hi) fail(*n, key, std::to_string(v) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return v;
+  }
+  std::optional<std::string> string(const std::string& key) {
+    const toml::node* n = get(key);
+    if (!n) return std::nullopt;
+    if (!n->is_string() || n->as_string()->get().empty()) fail(*n, key, "must be a non-empty string");
+    return n->as_string()->get();
+  }
+  std::optional<bool> boolean(const std::string& key) {
+    const toml::node* n = get(key);
+    if (!n) return std::nullopt;
+    if (!n->is_boolean()) fail(*n, key, "must be true or false");
+    return n->as_boolean()->get();
+  }
+  std::optional<Vec3> vec3(const std::string& key) {
+    const toml::node* n = get(key);
+    if (!n) return std::nullopt;
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 3) fail(*n, key, "must be [x, y, z] in mm");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) {
+      const toml::node& e = *a->get(static_cast<std::size_t>(i));
+      if (e.is_integer()) v[i] = static_cast<double>(e.as_integer()->get());
+      else if (e.is_floating_point()) v[i] = e.as_floating_point()->get();
+      else fail(*n, key, "must be [x, y, z] in mm");
+      if (!std::isfinite(v[i]) || std::abs(v[i]) > 50.0) fail(*n, key, "each coordinate must be within ±50 mm");
+    }
+    return v;
+  }
+  void refuse_unknown(const std::string& known) const {
+    for (const auto& [k, v] : t_) {
+      if (!seen_.count(std::string(k.str()))) fail(v, std::string(k.str()), "unknown key (" + known + ")");
+    }
+  }
+
+ private:
+  const toml::table& t_;
+  std::string origin_, where_;
+  std::set<std::string> seen_;
+};
+
+const std::set<std::string> kFaultKinds = {"nan", "range", "stuck", "jump", "version", "unknown", "drop", "disconnect"};
+
+}  // namespace
+
+SurgicalScript parse_surgical_script(const std::string& text, const std::string& origin) {
+  if (const files::TomlProblem p = files::toml_guard(text))
+    throw std::runtime_error(origin + ":" + std::to_string(p.line) + ":" + std::to_string(p.column) + ": " + p.why);
+  toml::table root;
+  try {
+    root = toml::parse(text, origin);
+  } catch (const toml::parse_error& e) {
+    throw std::runtime_error(origin + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  SurgicalScript s;
+  s.file = origin;
+  Reader top(root, origin, "");
+  const toml::node* head = top.get("script");
+  if (!head || !head->is_table()) throw std::runtime_error(origin + ":1: script: no [script] table (version = " + std::to_string(kSurgicalScriptVersion) + ")");
+  {
+    Reader r(*head->as_table(), origin, "script.");
+    const auto version = r.number("version", 0, 1e6);
+    if (!version) r.fail_here("version", "missing (" + std::to_string(kSurgicalScriptVersion) + ")");
+    if (*version != kSurgicalScriptVersion)
+      r.fail(*r.get("version"), "version", "this is a version " + std::to_string(static_cast<long>(*version)) +
+                                               " script; this vitreo reads version " + std::to_string(kSurgicalScriptVersion));
+    const auto name = r.string("case");
+    if (!name) r.fail_here("case", "missing: the case this script is written for");
+    s.case_name = *name;
+    s.kind = r.string("kind").value_or("test");
+    if (s.kind != "expert" && s.kind != "clumsy" && s.kind != "idle" && s.kind != "test")
+      r.fail(*r.get("kind"), "kind", "must be expert, clumsy, idle or test");
+    s.summary = r.string("summary").value_or("");
+    s.duration_s = r.number("duration_s", 0.01, 3600).value_or(s.duration_s);
+    s.seed = static_cast<std::uint64_t>(r.number("seed", 0, 1e15).value_or(1));
+    s.tremor_mm = r.number("tremor_mm", 0, 2).value_or(0);
+    s.speed_scale = r.number("speed_scale", 0.05, 20).value_or(1);
+    s.press_mm = r.number("press_mm", -2, 2).value_or(0);
+    r.refuse_unknown("version, case, kind, summary, duration_s, seed, tremor_mm, speed_scale, press_mm");
+  }
+  if (const toml::node* hands = top.get("hand")) {
+    const toml::array* a = hands->as_array();
+    if (!a || !a->is_array_of_tables()) top.fail(*hands, "hand", "must be [[hand]] tables");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::table& t = *a->get(i)->as_table();
+      const std::string where = "hand[" + std::to_string(i) + "].";
+      Reader r(t, origin, where);
+      ScriptHand h;
+      h.line = line_of(t);
+      h.tracker = static_cast<int>(r.number("tracker", 0, kTrackedInstruments - 1).value_or(0));
+      if (r.get("tracker") && r.get("tracker")->is_floating_point()) r.fail(*r.get("tracker"), "tracker", "must be 0 or 1");
+      for (const auto& other : s.hands)
+        if (other.tracker == h.tracker) r.fail_here("tracker", "a second hand on tracker " + std::to_string(h.tracker));
+      h.speed_mm_s = r.number("speed_mm_s", 0.1, 100).value_or(h.speed_mm_s);
+      const toml::node* wps = r.get("waypoint");
+      if (!wps || !wps->is_array_of_tables()) r.fail_here("waypoint", "a hand needs [[hand.waypoint]] tables");
+      const toml::array& wa = *wps->as_array();
+      for (std::size_t j = 0; j < wa.size(); ++j) {
+        const toml::table& wt = *wa.get(j)->as_table();
+        Reader w(wt, origin, where + "waypoint[" + std::to_string(j) + "].");
+        ScriptWaypoint p;
+        p.line = line_of(wt);
+        const auto to = w.string("to");
+        if (!to) w.fail_here("to", "missing: the landmark this waypoint goes to");
+        p.to = *to;
+        p.above_mm = w.number("above_mm", -10, 30).value_or(0);
+        p.toward_port_mm = w.number("toward_port_mm", -15, 15).value_or(0);
+        p.offset_mm = w.vec3("offset_mm").value_or(Vec3::Zero());
+        p.at_s = w.number("at_s", 0, 3600);
+        p.speed_mm_s = w.number("speed_mm_s", 0.1, 100);
+        p.duration_s = w.number("duration_s", 0, 600);
+        p.hold_s = w.number("hold_s", 0, 600).value_or(0);
+        p.jaws = w.number("jaws", 0, 1);
+        p.tool = w.string("tool");
+        if (p.tool && h.tracker != kToolTracker) w.fail(*w.get("tool"), "tool", "only the working hand (tracker 0) switches tools");
+        p.vacuum = w.number("vacuum", 0, 1);
+        p.cut_rate = w.number("cut_rate", 0, 1);
+        p.laser = w.boolean("laser");
+        p.reflux = w.boolean("reflux");
+        p.air = w.boolean("air");
+        w.refuse_unknown("to, above_mm, toward_port_mm, offset_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, tool, vacuum, cut_rate, laser, reflux, air");
+        h.waypoints.push_back(std::move(p));
+      }
+      r.refuse_unknown("tracker, speed_mm_s, waypoint");
+      s.hands.push_back(std::move(h));
+    }
+  }
+  if (const toml::node* faults = top.get("fault")) {
+    const toml::array* a = faults->as_array();
+    if (!a || !a->is_array_of_tables()) top.fail(*faults, "fault", "must be [[fault]] tables");
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::table& t = *a->get(i)->as_table();
+      Reader r(t, origin, "fault[" + std::to_string(i) + "].");
+      ScriptFault f;
+      f.line = line_of(t);
+      const auto device = r.string("device");
+      if (!device || (*device != "tracker-0" && *device != "tracker-1" && *device != "pedals" && *device != "eyeball"))
+        r.fail_here("device", "must be tracker-0, tracker-1, pedals or eyeball");
+      f.device = *device;
+      const auto kind = r.string("kind");
+      if (!kind || !kFaultKinds.count(*kind)) r.fail_here("kind", "must be nan, range, stuck, jump, version, unknown, drop or disconnect");
+      f.kind = *kind;
+      const auto at = r.number("at_s", 0, 3600);
+      if (!at) r.fail_here("at_s", "missing");
+      f.at_s = *at;
+      f.duration_s = r.number("duration_s", 0, 3600).value_or(0);
+      f.value = r.number("value", -1e6, 1e6).value_or(0);
+      r.refuse_unknown("device, kind, at_s, duration_s, value");
+      s.faults.push_back(f);
+    }
+  }
+  top.refuse_unknown("script, hand, fault");
+  return s;
+}
+
+SurgicalScript read_surgical_script(const std::string& path) {
+  const auto file = files::read_text_file(path);
+  if (!file.text) throw std::runtime_error(path + ": " + file.error);
+  return parse_surgical_script(*file.text, path);
+}
+
+namespace {
+
+// Where a landmark lies and which way is "up" from the tissue there (toward the globe centre).
+struct Landmark {
+  Vec3 at = Vec3::Zero();
+  Vec3 inward = Vec3::UnitZ();
+};
+
+std::vector<Vec3> alive_positions(const core::TissueWorld& w, std::uint32_t surface) {
+  const auto& s = w.surface(surface);
+  std::vector<Vec3> out;
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v)
+    if (s.vertex_alive(v)) out.push_back(s.position(v));
+  return out;
+}
+
+Vec3 centroid(const std::vector<Vec3>& pts) {
+  Vec3 c = Vec3::Zero();
+  for (const auto& p : pts) c += p;
+  return pts.empty() ? c : Vec3(c / static_cast<double>(pts.size()));
+}
+
+class LandmarkResolver {
+ public:
+  LandmarkResolver(const PreparedCase& c, const SurgicalScript& s) : c_(c), s_(s) {}
+
+  Landmark resolve(const std::string& name, int tracker, int line, const std::string& key) const {
+    const core::Scene& scene = *c_.scene;
+    const Vec3 centre = scene.eye.wall.center();
+    auto on_fundus = [&](const Vec3& p) { return Landmark{p, (centre - p).normalized()}; };
+    auto wall = [&](const core::FundusLocation& at) { return on_fundus(scene.eye.wall_point(at.polar_deg * kDeg, at.azimuth_deg * kDeg)); };
+    const auto dot = name.find('.');
+    const std::string head = name.substr(0, dot);
+    const std::string rest = dot == std::string::npos ? "" : name.substr(dot + 1);
+    const auto dot2 = rest.find('.');
+    const std::string item = rest.substr(0, dot2);
+    const std::string part = dot2 == std::string::npos ? "" : rest.substr(dot2 + 1);
+    const Port& port = c_.tracker_ports[tracker];
+    if (name == "port") return Landmark{port.position_mm, -port.outward};
+    if (name == "fovea") return on_fundus(scene.eye.fovea_mm);
+    if (name == "disc") return on_fundus(scene.eye.optic_disc_mm);
+    if (name == "roi") return on_fundus(c_.focus_mm);
+    if (head == "membrane") {
+      for (const auto& m : scene.membranes) {
+        if (m.name != item) continue;
+        const auto pts = alive_positions(scene.world, m.surface);
+        const Vec3 c = centroid(pts);
+        const Landmark mid = on_fundus(c);
+        // The fundus direction toward the hand's port, and toward the disc, at the membrane.
+        auto tangent_to = [&](const Vec3& p) {
+          Vec3 d = p - c;
+          d -= d.dot(mid.inward) * mid.inward;
+          return d.norm() > 1e-9 ? Vec3(d.normalized()) : Vec3::UnitX();
+        };
+        double radius = 0.0;
+        for (const auto& p : pts) radius = std::max(radius, (p - c).norm());
+        auto extreme = [&](const Vec3& dir, double fraction) {
+          // the membrane vertex farthest along dir within `fraction` of the radius
+          Vec3 best = c;
+          double best_d = -1e300;
+          for (const auto& p : pts) {
+            if ((p - c).norm() > fraction * radius + 1e-9) continue;
+            const double d = (p - c).dot(dir);
+            if (d > best_d) best_d = d, best = p;
+          }
+          return on_fundus(best);
+        };
+        if (part.empty() || part == "centre") return on_fundus(c);
+        if (part == "edge") return extreme(tangent_to(port.position_mm), 1.0);
+        if (part == "mid") return extreme(tangent_to(port.position_mm), 0.5);
+        if (part == "far_edge") return extreme(-tangent_to(port.position_mm), 1.0);
+        if (part == "disc_edge") return extreme(tangent_to(scene.eye.optic_disc_mm), 1.0);
+        fail(line, key, "membrane." + item + "." + part + ": no such part (centre, edge, mid, far_edge, disc_edge)");
+      }
+      fail(line, key, "the case has no membrane '" + item + "'");
+    }
+    if (head == "tear") {
+      for (std::size_t i = 0; i < scene.description.tears.size(); ++i) {
+        const auto& t = scene.description.tears[i];
+        if (t.name != item) continue;
+        if (part.empty()) return wall(t.center);
+        if (part == "flap" && i < scene.tears.size() && scene.retina != core::kNone) {
+          const auto& surf = scene.world.surface(scene.retina);
+          std::vector<Vec3> pts;
+          for (auto v : scene.tears[i].flap_vertices)
+            if (surf.vertex_alive(v)) pts.push_back(surf.position(v));
+          if (!pts.empty()) return on_fundus(centroid(pts));
+        }
+        if (part == "hinge") {  // the U's open end lies anterior (toward the ora) of its centre
+          core::FundusLocation h = t.center;
+          h.polar_deg += 0.5 * t.length_mm / (scene.eye.parameters.globe_diameter_mm * 0.5) / kDeg;
+          return wall(h);
+        }
+        fail(line, key, "tear." + item + "." + part + ": no such part (flap, hinge)");
+      }
+      fail(line, key, "the case has no tear '" + item + "'");
+    }
+    if (head == "detachment") {
+      for (const auto& d : scene.description.detachments)
+        if (d.name == item) return wall(d.center);
+      fail(line, key, "the case has no detachment '" + item + "'");
+    }
+    if (head == "guide") {
+      for (const auto& g : scene.guides) {
+        if (g.name != item) continue;
+        if (g.polyline_mm.empty()) fail(line, key, "guide '" + item + "' has no points");
+        if (part.empty()) return on_fundus(centroid(g.polyline_mm));
+        if (part == "start") return on_fundus(g.polyline_mm.front());
+        if (part == "end") return on_fundus(g.polyline_mm.back());
+        char* end = nullptr;
+        const long k = std::strtol(part.c_str(), &end, 10);
+        if (end && *end == '\0' && k >= 0 && k < static_cast<long>(g.polyline_mm.size())) return on_fundus(g.polyline_mm[static_cast<std::size_t>(k)]);
+        fail(line, key, "guide." + item + "." + part + ": no such point (start, end, 0.." + std::to_string(g.polyline_mm.size() - 1) + ")");
+      }
+      fail(line, key, "the case has no guide '" + item + "'");
+    }
+    fail(line, key, "unknown landmark '" + name + "' (port, fovea, disc, roi, membrane.NAME…, tear.NAME…, detachment.NAME, guide.NAME…)");
+  }
+
+  [[noreturn]] void fail(int line, const std::string& key, const std::string& why) const {
+    throw std::runtime_error(s_.file + ":" + std::to_string(line) + ": " + key + ": " + why);
+  }
+
+ private:
+  const PreparedCase& c_;
+  const SurgicalScript& s_;
+};
+
+std::string tracker_key(double t_ms, const Vec3& p, double jaws) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "key %.1f %.4f %.4f %.4f 0 0 0 %.3f\n", t_ms, p.x(), p.y(), p.z(), jaws);
+  return buf;
+}
+
+// The pedal's state as the emulator plays it: two axes and a switch word.
+struct PedalState {
+  double vacuum = 0.0, cut_rate = 0.0;
+  unsigned switches = 0;
+};
+
+}  // namespace
+
+ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals) {
+  const core::Scene& scene = *c.scene;
+  if (!scene.description.name.empty() && script.case_name != scene.description.name)
+    throw std::runtime_error(script.file + ": script.case: written for '" + script.case_name + "', not for '" + scene.description.name + "'");
+  LandmarkResolver landmarks(c, script);
+  ResolvedScript out;
+  out.duration_s = script.duration_s;
+  // The working hand's tools in the order the instrument switch cycles through them.
+  std::vector<std::string> tools;
+  for (const auto& name : scene.description.instruments) {
+    core::InstrumentKind k;
+    if (instrument_kind(name, k) && k != core::InstrumentKind::kLightPipe) tools.push_back(name);
+  }
+  const Vec3 centre = scene.eye.wall.center();
+  struct PedalChange {
+    double t_s;
+    std::optional<double> vacuum, cut_rate;
+    std::optional<bool> laser, reflux, air;
+    int presses = 0;  // instrument switch
+    int line;
+  };
+  std::vector<PedalChange> changes;
+  std::mt19937_64 rng(script.seed * 7919 + 17);
+  std::normal_distribution<double> tremor(0.0, 1.0);
+
+  for (const ScriptHand& hand : script.hands) {
+    const std::string hand_key = "hand[" + std::to_string(&hand - script.hands.data()) + "]";
+    if (hand.tracker == kLightPipeTracker && c.light_pipe < 0)
+      landmarks.fail(hand.line, hand_key + ".tracker", "the case has no light pipe for the second hand");
+    if (hand.tracker == kToolTracker && tools.empty()) landmarks.fail(hand.line, hand_key + ".tracker", "the case has no tools for the working hand");
+    const Port& port = c.tracker_ports[hand.tracker];
+    Vec3 pos = port.position_mm + 2.0 * port.outward;  // the tip waits outside its cannula
+    double jaws = 0.0, t = 0.0;
+    int tool = 0;
+    std::string keys = tracker_key(0, pos, 0);
+    auto add_segment = [&](const Vec3& to, double to_jaws, double duration) {
+      // Tremor: seeded offsets at 20 Hz along the way (none while the hand is outside the eye).
+      const int n = script.tremor_mm > 0.0 ? std::max(1, static_cast<int>(duration * 20.0)) : 1;
+      for (int i = 1; i <= n; ++i) {
+        const double f = static_cast<double>(i) / n;
+        Vec3 p = pos + f * (to - pos);
+        if (script.tremor_mm > 0.0 && i < n) p += script.tremor_mm * Vec3(tremor(rng), tremor(rng), tremor(rng));
+        keys += tracker_key((t + f * duration) * 1e3, p, jaws + f * (to_jaws - jaws));
+      }
+      out.path_mm[hand.tracker] += (to - pos).norm();
+      t += duration;
+      pos = to;
+      jaws = to_jaws;
+    };
+    for (std::size_t i = 0; i < hand.waypoints.size(); ++i) {
+      const ScriptWaypoint& w = hand.waypoints[i];
+      const std::string key = hand_key + ".waypoint[" + std::to_string(i) + "]";
+      if (w.at_s && *w.at_s > t) add_segment(pos, jaws, *w.at_s - t);  // wait in place
+      PedalChange ch{t, w.vacuum, w.cut_rate, w.laser, w.reflux, w.air, 0, w.line};
+      if (w.tool) {
+        const auto it = std::find(tools.begin(), tools.end(), *w.tool);
+        if (it == tools.end()) landmarks.fail(w.line, key + ".tool", "the case offers no " + *w.tool + " to the working hand");
+        const int want = static_cast<int>(it - tools.begin());
+        ch.presses = (want - tool + static_cast<int>(tools.size())) % static_cast<int>(tools.size());
+        tool = want;
+        // a press takes 100 ms (down, up) and the hand waits for the switch
+        if (ch.presses > 0) add_segment(pos, jaws, 0.1 * ch.presses + 0.05);
+      }
+      if (ch.vacuum || ch.cut_rate || ch.laser || ch.reflux || ch.air || ch.presses) changes.push_back(ch);
+      const Landmark l = landmarks.resolve(w.to, hand.tracker, w.line, key + ".to");
+      Vec3 tangent_to_port = port.position_mm - l.at;
+      tangent_to_port -= tangent_to_port.dot(l.inward) * l.inward;
+      tangent_to_port = tangent_to_port.norm() > 1e-9 ? Vec3(tangent_to_port.normalized()) : Vec3::Zero();
+      // Pressing harder: every waypoint at or within 0.5 mm of tissue goes press_mm deeper.
+      const bool touching = w.to != "port" && w.above_mm <= 0.5;
+      const double above = w.above_mm - (touching ? script.press_mm : 0.0);
+      const Vec3 target = l.at + above * l.inward + w.toward_port_mm * tangent_to_port + w.offset_mm;
+      // Reachable: inside the globe, and no farther from the port than a 32 mm shaft reaches.
+      if (w.to != "port" || w.above_mm > 0.0) {
+        const Vec3 d = target - centre;
+        const double wall_r = scene.eye.wall.radius_toward(d.normalized());
+        if (d.norm() > wall_r + 0.3) landmarks.fail(w.line, key, "unreachable: " + std::to_string(d.norm() - wall_r) + " mm beyond the eye wall");
+        if ((target - port.position_mm).norm() > 32.0) landmarks.fail(w.line, key, "unreachable: farther than a 32 mm shaft from the port");
+      }
+      const double dist = (target - pos).norm();
+      const double speed = w.speed_mm_s.value_or(hand.speed_mm_s) * script.speed_scale;
+      const double duration = w.duration_s ? *w.duration_s / script.speed_scale : dist / speed;
+      add_segment(target, w.jaws.value_or(jaws), std::max(duration, 0.001));
+      if (w.hold_s > 0.0) add_segment(pos, jaws, w.hold_s / script.speed_scale);
+    }
+    const std::string name = "tracker-" + std::to_string(hand.tracker);
+    std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool 3\ninstrument " +
+                         std::to_string(hand.tracker) + "\nloop 0\nseed " + std::to_string(script.seed + static_cast<std::uint64_t>(hand.tracker)) + "\n";
+    out.device_scripts[name] = header + keys;
+  }
+
+  if (!out.device_scripts.count("tracker-0")) {  // no working hand scripted: it stays outside the eye
+    const Port& port = c.tracker_ports[kToolTracker];
+    out.device_scripts["tracker-0"] = "device tracker\nrate_hz 1000\nserial 1001\ntool 3\ninstrument 0\nloop 0\nseed " +
+                                      std::to_string(script.seed) + "\n" + tracker_key(0, port.position_mm + 2.0 * port.outward, 0);
+  }
+
+  // The pedals: changes in time order, each a step (two keys 1 ms apart); a switch press is 50 ms
+  // down, 50 ms up. Laser, reflux and air hold their switch while on; the air switch toggles.
+  std::stable_sort(changes.begin(), changes.end(), [](const PedalChange& a, const PedalChange& b) { return a.t_s < b.t_s; });
+  auto bit = [](int b) { return b >= 0 && b < 16 ? 1u << b : 0u; };
+  PedalState st;
+  bool air = false;
+  std::string pkeys;
+  auto pedal_key = [&](double t_ms, const PedalState& p) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "key %.1f %.3f %.3f %u\n", t_ms, p.vacuum, p.cut_rate, p.switches);
+    pkeys += buf;
+  };
+  pedal_key(0, st);
+  double last_ms = 0.0;
+  for (const auto& ch : changes) {
+    double t_ms = std::max(ch.t_s * 1e3, last_ms + 1.0);
+    pedal_key(t_ms, st);
+    PedalState next = st;
+    if (ch.vacuum) next.vacuum = *ch.vacuum;
+    if (ch.cut_rate) next.cut_rate = *ch.cut_rate;
+    if (ch.laser) next.switches = *ch.laser ? next.switches | bit(pedals.laser_switch) : next.switches & ~bit(pedals.laser_switch);
+    if (ch.reflux) next.switches = *ch.reflux ? next.switches | bit(pedals.reflux_switch) : next.switches & ~bit(pedals.reflux_switch);
+    for (int i = 0; i < ch.presses; ++i) {
+      pedal_key(t_ms + 1.0, PedalState{st.vacuum, st.cut_rate, st.switches | bit(pedals.instrument_switch)});
+      pedal_key(t_ms + 50.0, PedalState{st.vacuum, st.cut_rate, st.switches | bit(pedals.instrument_switch)});
+      pedal_key(t_ms + 51.0, st);
+      t_ms += 100.0;
+      pedal_key(t_ms, st);
+    }
+    if (ch.air && *ch.air != air) {  // one press toggles fluid ↔ air
+      air = *ch.air;
+      pedal_key(t_ms + 1.0, PedalState{st.vacuum, st.cut_rate, st.switches | bit(pedals.air_switch)});
+      pedal_key(t_ms + 50.0, PedalState{st.vacuum, st.cut_rate, st.switches | bit(pedals.air_switch)});
+      pedal_key(t_ms + 51.0, st);
+      t_ms += 52.0;
+    }
+    pedal_key(t_ms + 1.0, next);
+    st = next;
+    last_ms = t_ms + 1.0;
+  }
+  pedal_key(std::max(last_ms + 1.0, script.duration_s * 1e3), st);
+  out.device_scripts["pedals"] = "device pedals\nrate_hz 500\nserial 2001\nloop 0\nseed " + std::to_string(script.seed + 10) + "\n" + pkeys;
+  out.device_scripts["eyeball"] = "device eyeball\nrate_hz 250\nserial 3001\nloop 0\nseed " + std::to_string(script.seed + 20) +
+                                  "\nkey 0 0 0 0 0 0\nkey " + std::to_string(static_cast<long>(script.duration_s * 1e3) + 1) + " 0 0 0 0 0\n";
+  for (const ScriptFault& f : script.faults) {
+    auto it = out.device_scripts.find(f.device);
+    if (it == out.device_scripts.end())
+      throw std::runtime_error(script.file + ":" + std::to_string(f.line) + ": fault.device: " + f.device + " is not played by this script");
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "fault %.1f %.1f %s %g\n", f.at_s * 1e3, f.duration_s * 1e3, f.kind.c_str(), f.value);
+    it->second += buf;
+  }
+  return out;
+}
+
+}  // namespace vitreo::rig

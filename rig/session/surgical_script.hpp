@@ -1,0 +1,98 @@
+#pragma once
+// Surgical scripts: a scripted surgeon, written by a person, in TOML (scenes/scripts/README.md
+// documents the format). Two tracked hands move between waypoints named after the case's landmarks
+// (its port, the fovea, the disc, a membrane's edge, a tear, a guide's points) at given speeds, close
+// and open their jaws, select tools and work the pedals; device faults can be injected on top.
+//
+// A script is open loop, like a recorded hand: resolve_script() turns it, once, against the case as
+// loaded (its anatomy and resolution) into the device emulators' keyframe scripts
+// (drivers/sim/emulator.hpp), and nothing it does while playing reads the simulation. A landmark
+// the case lacks, a tool it does not offer, or a waypoint no instrument through its port can reach
+// is an error when the script is resolved, with the file, line and key.
+//
+// The script then plays through the whole stack: emulators → transports → drivers → rig → core →
+// metrics, in lockstep (rig/session/device_hub.hpp) so its outcome never depends on load.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/common/types.hpp"
+#include "rig/input/controls.hpp"
+#include "rig/session/case_runtime.hpp"
+
+namespace vitreo::rig {
+
+inline constexpr int kSurgicalScriptVersion = 1;
+
+// One waypoint of a hand: where the tip goes, how fast, what it does on the way and once there.
+struct ScriptWaypoint {
+  int line = 0;               // in the script file (diagnostics)
+  std::string to;             // landmark (see resolve_script)
+  double above_mm = 0.0;      // along the landmark's inward normal (toward the globe centre); at a port, depth inside
+  double toward_port_mm = 0.0;  // along the fundus toward the hand's port (a peel's direction)
+  core::Vec3 offset_mm = core::Vec3::Zero();  // in the eye frame, on top
+  std::optional<double> at_s;      // do not leave before this session time
+  std::optional<double> speed_mm_s;  // default: the hand's speed
+  std::optional<double> duration_s;  // instead of a speed
+  double hold_s = 0.0;             // stay once there
+  std::optional<double> jaws;      // 0 open .. 1 closed, reached on arrival
+  std::optional<std::string> tool;  // working hand: select this tool (instrument-switch presses) before leaving
+  // Pedals from this waypoint's start on (unset: unchanged).
+  std::optional<double> vacuum;    // 0..1 of the vitrectomy pedal's travel
+  std::optional<double> cut_rate;  // 0..1 of the side travel
+  std::optional<bool> laser, reflux, air;
+};
+
+struct ScriptHand {
+  int line = 0;
+  int tracker = 0;  // 0: the working hand (tools, port working_1); 1: the other (light pipe, working_2)
+  double speed_mm_s = 5.0;
+  std::vector<ScriptWaypoint> waypoints;
+};
+
+struct ScriptFault {
+  int line = 0;
+  std::string device;  // "tracker-0", "tracker-1", "pedals", "eyeball"
+  double at_s = 0.0, duration_s = 0.0;
+  std::string kind;    // drvers/sim's fault kinds: nan, range, stuck, jump, version, unknown, drop, disconnect
+  double value = 0.0;  // jump: milliseconds
+};
+
+struct SurgicalScript {
+  std::string file;        // where it was read from
+  std::string case_name;   // the case it is written for
+  std::string kind;        // expert, clumsy, idle, test
+  std::string summary;     // what it does (and, for a clumsy one, what it does wrong)
+  double duration_s = 10.0;
+  std::uint64_t seed = 1;  // sensor noise and tremor
+  // Degradations, for sweeps from an expert script: hand tremor (1 σ, mm, 20 Hz), speed factor,
+  // extra pressing depth past every waypoint that touches tissue (mm).
+  double tremor_mm = 0.0;
+  double speed_scale = 1.0;
+  double press_mm = 0.0;
+  std::vector<ScriptHand> hands;
+  std::vector<ScriptFault> faults;
+};
+
+// Parses a script; throws std::runtime_error "FILE:LINE: KEY: why" on malformed input.
+SurgicalScript parse_surgical_script(const std::string& text, const std::string& origin);
+SurgicalScript read_surgical_script(const std::string& path);
+
+// The script as the simulated devices play it: one emulator script per device name ("tracker-0",
+// "tracker-1" when the second hand is scripted, "pedals", "eyeball").
+struct ResolvedScript {
+  std::map<std::string, std::string> device_scripts;
+  double duration_s = 0.0;
+  double path_mm[2] = {0.0, 0.0};  // planned tip path per hand (tremor excluded)
+};
+
+// Resolves the landmarks against the case as loaded; throws std::runtime_error "FILE:LINE: KEY: why"
+// for a landmark, a tool or a light pipe the case lacks, and for an unreachable waypoint.
+// Landmarks: port (the hand's own), fovea, disc, roi (the case's region of interest),
+// membrane.NAME[.centre|.edge|.mid|.far_edge|.disc_edge], tear.NAME[.flap|.hinge],
+// detachment.NAME, guide.NAME[.start|.end|.N] (N: the guide's N-th point).
+ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals);
+
+}  // namespace vitreo::rig
