@@ -34,6 +34,10 @@ struct RigidAnatomy {
   bool has_lens = false;
   Vec3 lens_center_mm = Vec3::Zero();
   Vec3 lens_semi_axes_mm{4.5, 4.5, 2.0};  // axis-aligned ellipsoid (the crystalline lens)
+  // The simulated retina is a surface laid on the globe wall, without thickness; a real one is
+  // ~0.25 mm thick. An instrument reaches the wall (choroid, sclera) only after pressing this deep
+  // into the retina — touching the retina to grasp a membrane on it is not a wall contact.
+  double retina_thickness_mm = 0.0;
 };
 
 struct CollisionOptions {

@@ -46,7 +46,13 @@ void InstrumentSystem::update_grasps(InstrumentEvents& events) {
     const bool closing = st.input.actuation >= options_.grasp_close_actuation &&
                          previous_input_[i].actuation < options_.grasp_close_actuation;
     if (st.grip == kNone && st.inside && closing) {
-      const SurfacePoint sp = collision_->nearest_point(world_, st.tip.grasp_point, options_.grasp_radius_mm);
+      // Jaws closing on a membrane that lies on the retina close on the membrane: it is the layer
+      // the jaws meet first. The nearest point of every other surface is tried before the retina's
+      // (at equal distance the retina used to win, and a peel became a retinal tear).
+      const std::uint32_t retina = options_.retina_surface;
+      const std::uint32_t not_retina = retina < 32 ? ~(1u << retina) : ~0u;
+      SurfacePoint sp = collision_->nearest_point(world_, st.tip.grasp_point, options_.grasp_radius_mm, not_retina);
+      if (!sp.found && not_retina != ~0u) sp = collision_->nearest_point(world_, st.tip.grasp_point, options_.grasp_radius_mm);
       if (sp.found) {
         GripDescription g;
         g.surface = sp.surface;

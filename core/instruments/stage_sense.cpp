@@ -64,6 +64,12 @@ void InstrumentSystem::sense(const StepReport& report, InstrumentEvents& events)
   rigid_contacts(events);
 }
 
+namespace {
+// How far inside the eye a trocar cannula and the pars plana around it reach (a 23/25G cannula's
+// tube stands ~1 mm in; the entry's wall is within another half millimetre).
+constexpr double kCannulaReachMm = 1.5;
+}  // namespace
+
 void InstrumentSystem::rigid_contacts(InstrumentEvents& events) {
   const std::uint32_t n = static_cast<std::uint32_t>(state_.size());
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -76,8 +82,12 @@ void InstrumentSystem::rigid_contacts(InstrumentEvents& events) {
     const bool touching_lens = lens <= 0.0;
     if (touching_lens && !lens_touching_[i]) events.emit(InstrumentEventKind::kLensTouch, i, kNone, a.frame.tip, -lens);
     lens_touching_[i] = touching_lens;
-    const double wall = a.inside ? world_.wall().clearance(a.frame.tip) - shaft_radius_mm(a.description.gauge)
-                                 : std::numeric_limits<double>::infinity();
+    // Not within the cannula's reach of its own port: there the instrument goes through the wall
+    // by design (every entry used to count as a wall contact).
+    const bool in_cannula = (a.frame.tip - options_.ports_mm[a.description.port]).norm() < kCannulaReachMm;
+    const double wall = a.inside && !in_cannula ? world_.wall().clearance(a.frame.tip) - shaft_radius_mm(a.description.gauge) +
+                                                      options_.anatomy.retina_thickness_mm
+                                                : std::numeric_limits<double>::infinity();
     if (wall < 0.0 && !wall_touching_[i]) events.emit(InstrumentEventKind::kWallContact, i, kNone, a.frame.tip, -wall);
     wall_touching_[i] = wall < 0.0;
     // Other instruments (FCL capsule–capsule).

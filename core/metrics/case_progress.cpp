@@ -69,6 +69,10 @@ CaseProgress::CaseProgress(const TissueWorld& world, MetricsCase c, ProgressOpti
       throw InvalidArgument("metrics: membrane '" + m.name + "': attachments out of range");
     }
     membrane_area_start_.push_back(world.surface(m.surface).total_rest_area());
+    // membrane_freed's work space, with room for the vertices cuts add (no allocation while measuring)
+    const std::size_t room = 2 * static_cast<std::size_t>(world.surface(m.surface).vertex_slots());
+    piece_parent_.reserve(std::max(piece_parent_.capacity(), room));
+    piece_held_.reserve(std::max(piece_held_.capacity(), room));
   }
   for (const auto& d : case_.detachments) {
     if (d.local_force >= world.local_force_count()) throw InvalidArgument("metrics: detachment '" + d.name + "': no such local force");
@@ -93,7 +97,8 @@ CaseProgress::CaseProgress(const TissueWorld& world, MetricsCase c, ProgressOpti
         if (case_.gel == kNone) throw InvalidArgument("metrics: gel_removed needs a gel");
         break;
       case CriterionKind::kMembraneRemoved:
-      case CriterionKind::kMembraneReleased: item = find(case_.membranes, spec.target, "membrane"); break;
+      case CriterionKind::kMembraneReleased:
+      case CriterionKind::kMembraneFreed: item = find(case_.membranes, spec.target, "membrane"); break;
       case CriterionKind::kPathCut:
       case CriterionKind::kLaserCoverage: {
         const std::uint32_t g = find(case_.guides, spec.target, "guide");
@@ -176,6 +181,44 @@ double CaseProgress::membrane_released(const TissueWorld& world, std::uint32_t m
   return static_cast<double>(released) / mb.attachment_count;
 }
 
+double CaseProgress::membrane_freed(const TissueWorld& world, std::uint32_t m) const {
+  // Pieces of the membrane: vertices joined through live triangles (union–find). A piece is held
+  // when one of its vertices carries an attachment that holds; the rest is free — peeled off and
+  // cut loose, or removed (no longer there at all).
+  const MetricsCase::Membrane& mb = case_.membranes[m];
+  const Surface& s = world.surface(mb.surface);
+  const double start = membrane_area_start_[m];
+  if (!(start > 0.0)) return 0.0;
+  std::vector<std::uint32_t>& parent = piece_parent_;
+  parent.resize(s.vertex_slots());  // grows only when cuts add vertices
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) parent[v] = v;
+  const auto root = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+    if (!s.triangle_alive(t)) continue;
+    const auto tv = s.triangle_vertices(t);
+    const std::uint32_t r0 = root(tv[0]);
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t r = root(tv[static_cast<std::size_t>(k)]);
+      if (r != r0) parent[r] = r0;
+    }
+  }
+  std::vector<std::uint8_t>& held = piece_held_;
+  held.assign(s.vertex_slots(), 0);
+  for (std::uint32_t a = mb.first_attachment; a < mb.first_attachment + mb.attachment_count; ++a) {
+    if (!world.attachment_holds(a)) continue;
+    const std::uint32_t v = world.attachment_vertex_a(a);
+    if (v < s.vertex_slots()) held[root(v)] = 1;
+  }
+  double held_area = 0.0;
+  for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+    if (s.triangle_alive(t) && held[root(s.triangle_vertices(t)[0])]) held_area += s.triangle_rest_area(t);
+  }
+  return std::clamp(1.0 - held_area / start, 0.0, 1.0);
+}
+
 double CaseProgress::path_cut_fraction(const TissueWorld& world, GuideSamples& g) const {
   // A cut leaves boundary springs (one triangle) along it; those that were not boundary at the
   // start (the ora serrata, tears cut by the scene) are new. Springs split later are new too.
@@ -244,6 +287,7 @@ void CaseProgress::evaluate(const TissueWorld& world, const InstrumentSystem* in
         break;
       }
       case CriterionKind::kMembraneReleased: p.value = membrane_released(world, item); break;
+      case CriterionKind::kMembraneFreed: p.value = membrane_freed(world, item); break;
       case CriterionKind::kPathCut: p.value = path_cut_fraction(world, samples_[item]); break;
       case CriterionKind::kLaserCoverage: p.value = laser_fraction(world, instruments, samples_[item]); break;
       case CriterionKind::kDrained: p.value = world.local_force_scale(case_.detachments[item].local_force); break;

@@ -8,6 +8,8 @@
 //   gel_removed        fraction of the gel's vertices at the start that no longer exist
 //   membrane_removed   1 − rest area now / rest area at the start
 //   membrane_released  fraction of the membrane's attachments broken or with an end cut away
+//   membrane_freed     fraction of the membrane's start area removed or in pieces that no holding
+//                      attachment ties to the retina (peeled off and cut loose)
 //   path_cut           fraction of the guide's arc length within path_tolerance_mm (along the
 //                      wall) of a retina boundary edge that was not a boundary at the start
 //   laser_coverage     fraction of the ring's arc length within one spot radius of an adhered burn
@@ -105,6 +107,7 @@ class CaseProgress {
   double laser_fraction(const TissueWorld& world, const InstrumentSystem* instruments, GuideSamples& g) const;
   double retina_lift_mm(const TissueWorld& world) const;
   double membrane_released(const TissueWorld& world, std::uint32_t m) const;
+  double membrane_freed(const TissueWorld& world, std::uint32_t m) const;
 
   MetricsCase case_;
   ProgressOptions options_;
@@ -117,6 +120,9 @@ class CaseProgress {
   double lift_start_mm_ = 0.0;
   // Retina springs that were boundary edges at the start: generation per slot (kNone: not one).
   std::vector<std::uint32_t> boundary_start_;
+  // membrane_freed's work space (sized to the membrane's vertex slots once, grown by cuts only).
+  mutable std::vector<std::uint32_t> piece_parent_;
+  mutable std::vector<std::uint8_t> piece_held_;
 };
 
 // Distance from p to segment [a, b] measured along the wall: the radial part of the offset (tissue

@@ -13,6 +13,7 @@ void MetricsOptions::validate() const {
   require_range(retina_force_limit_un, -1e12, 1e12, "metrics: retina_force_limit_un");
   require_range(laser_target_band_mm, 0.0, 10.0, "metrics: laser_target_band_mm");
   require_range(odometer_stride_mm, 0.0, 1.0, "metrics: odometer_stride_mm");
+  require_range(static_cast<double>(completion_check_steps), 1.0, 1e6, "metrics: completion_check_steps");
   progress.validate();
   scores.validate();
 }
@@ -59,6 +60,23 @@ Status SessionMetrics::observe(double dt) {
     return Status::error("metrics: no physics step since the last observe()");
   }
   last_world_step_ = world_.step_count();
+  if (finished_) return Status::ok();  // the case is over: its score stands as it was
+  accumulate(dt);
+  if (++steps_since_check_ >= options_.completion_check_steps) {
+    steps_since_check_ = 0;
+    completed_ = complete();  // measures the criteria now
+    if (completed_ || (time_limit_s_ > 0.0 && totals_.elapsed_s >= time_limit_s_)) {
+      // The card as it stands now: criteria() and score() return it from here on.
+      compute_scores(totals_, progress_.criteria(), time_limit_s_, options_.scores, card_);
+      finished_ = true;
+      finished_at_s_ = totals_.elapsed_s;
+    }
+  }
+  return Status::ok();
+}
+
+void SessionMetrics::accumulate(double dt) {
+  const auto& world_events = world_.events();
   totals_.elapsed_s += dt;
   ++totals_.steps;
 
@@ -70,7 +88,7 @@ Status SessionMetrics::observe(double dt) {
       ++totals_.other_tears;
     }
   }
-  if (!sim_) return Status::ok();
+  if (!sim_) return;
 
   const double limit = totals_.force_limit_un;
   const LightExposure& light = sim_->light();
@@ -137,11 +155,11 @@ Status SessionMetrics::observe(double dt) {
       ++totals_.burns_elsewhere;
     }
   }
-  return Status::ok();
+  return;
 }
 
 const std::vector<CriterionProgress>& SessionMetrics::criteria() {
-  progress_.evaluate(world_, sim_ ? &sim_->instruments() : nullptr, totals_.elapsed_s);
+  if (!finished_) progress_.evaluate(world_, sim_ ? &sim_->instruments() : nullptr, totals_.elapsed_s);
   return progress_.criteria();
 }
 
@@ -156,6 +174,7 @@ bool SessionMetrics::complete() {
 }
 
 const ScoreCard& SessionMetrics::score() {
+  if (finished_ && !card_.categories.empty()) return card_;
   compute_scores(totals_, criteria(), time_limit_s_, options_.scores, card_);
   return card_;
 }

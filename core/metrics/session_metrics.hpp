@@ -27,6 +27,10 @@ namespace vitreo::core {
 struct MetricsOptions {
   // An instrument touches the retina while the retina's contact force on it exceeds this (µN).
   double contact_force_un = 1.0;
+  // Every this many observed steps the metrics check whether the case is over: every criterion met
+  // (complete) or its time limit passed. From then on the score stands: nothing more is counted,
+  // criteria() and score() return what they were at that step (EyeSi ends a module the same way).
+  std::uint32_t completion_check_steps = 100;
   // The odometer counts the tip's path in strides of at least this (mm): above sensor jitter.
   double odometer_stride_mm = 0.05;
   // Force above which the retina is damaged (µN); ≤ 0: the instruments' retina_force_limit_un.
@@ -78,9 +82,15 @@ class SessionMetrics final : public StepObserver {
   const ScoreCard& score();
   // What the last score() / criteria() found, without measuring again (the picture shows these).
   const ScoreCard& last_score() const { return card_; }
+  // The case is over (see MetricsOptions::completion_check_steps): completed, or out of time.
+  bool finished() const { return finished_; }
+  bool completed() const { return completed_; }
+  double finished_at_s() const { return finished_at_s_; }
   const CaseProgress& progress() const { return progress_; }
 
  private:
+  void accumulate(double dt);
+
   const TissueWorld& world_;
   const Simulation* sim_;
   MetricsOptions options_;
@@ -93,6 +103,9 @@ class SessionMetrics final : public StepObserver {
   std::uint64_t last_world_step_ = 0;
   double time_limit_s_ = 0.0;
   ScoreCard card_;
+  std::uint32_t steps_since_check_ = 0;
+  bool finished_ = false, completed_ = false;
+  double finished_at_s_ = 0.0;
 };
 
 }  // namespace vitreo::core

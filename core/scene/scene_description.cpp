@@ -41,6 +41,7 @@ const char* to_string(CriterionKind k) {
     case CriterionKind::kGelRemoved: return "gel_removed";
     case CriterionKind::kMembraneRemoved: return "membrane_removed";
     case CriterionKind::kMembraneReleased: return "membrane_released";
+    case CriterionKind::kMembraneFreed: return "membrane_freed";
     case CriterionKind::kPathCut: return "path_cut";
     case CriterionKind::kLaserCoverage: return "laser_coverage";
     case CriterionKind::kDrained: return "drained";
@@ -186,6 +187,7 @@ void SceneDescription::validate() const {
         break;
       case CriterionKind::kMembraneRemoved:
       case CriterionKind::kMembraneReleased:
+      case CriterionKind::kMembraneFreed:
         if (std::none_of(membranes.begin(), membranes.end(), [&](const auto& m) { return m.name == c.target; })) {
           throw InvalidArgument(w + "no membrane named '" + c.target + "'");
         }

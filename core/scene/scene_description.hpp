@@ -86,6 +86,7 @@ enum class CriterionKind : std::uint8_t {
   kDrained,           // detachment force scale ≤ threshold
   kRetinaFlat,        // largest retina lift from the wall (mm) ≤ threshold
   kTimeLimit,         // elapsed s ≤ threshold
+  kMembraneFreed,     // fraction of a membrane's area removed or in pieces no attachment holds ≥ threshold
 };
 struct CriterionSpec {
   CriterionKind kind = CriterionKind::kGelRemoved;

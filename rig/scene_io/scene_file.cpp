@@ -274,7 +274,7 @@ core::GuideKind guide_kind(Tab& t) {
 core::CriterionKind criterion_kind(Tab& t) {
   const std::string s = t.required_string("kind");
   using K = core::CriterionKind;
-  for (K k : {K::kGelRemoved, K::kMembraneRemoved, K::kMembraneReleased, K::kPathCut, K::kLaserCoverage, K::kDrained,
+  for (K k : {K::kGelRemoved, K::kMembraneRemoved, K::kMembraneReleased, K::kMembraneFreed, K::kPathCut, K::kLaserCoverage, K::kDrained,
               K::kRetinaFlat, K::kTimeLimit}) {
     if (s == core::to_string(k)) return k;
   }

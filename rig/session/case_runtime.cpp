@@ -95,6 +95,7 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   o.anatomy.lens_center_mm = core::Vec3(0.0, 0.0, s.eye.lens_center_z_mm);
   const auto& a = s.description.anatomy;
   o.anatomy.lens_semi_axes_mm = core::Vec3(0.5 * a.lens_diameter_mm, 0.5 * a.lens_diameter_mm, 0.5 * a.lens_thickness_mm);
+  o.anatomy.retina_thickness_mm = a.retina_thickness_mm;
   // Subretinal fluid drains through the break: the case's tear when it has one, else the centre.
   for (std::size_t i = 0; i < s.detachment_forces.size() && i < s.description.detachments.size(); ++i) {
     core::DrainageSite site;

@@ -75,6 +75,10 @@ telemetry::Event instrument_event(const core::InstrumentEvent& e, std::int64_t s
     default: ev.kind = telemetry::EventKind::Contact; break;  // forces, collisions, grasps, light dose
   }
   ev.instrument_id = e.instrument == core::kNone ? std::int8_t{-1} : static_cast<std::int8_t>(e.instrument);
+  // A grasp's, a lost grasp's and a broken attachment's `other` is the tissue surface.
+  const bool on_tissue = e.kind == core::InstrumentEventKind::kGrasp || e.kind == core::InstrumentEventKind::kGraspLost ||
+                         e.kind == core::InstrumentEventKind::kAttachmentBroken;
+  if (on_tissue && e.other != core::kNone) ev.tissue_id = static_cast<std::int32_t>(e.other);
   for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
   ev.magnitude = e.magnitude;
   return ev;
@@ -255,6 +259,11 @@ SessionSummary run_session(const SessionConfig& config) {
   std::size_t switches = 0;
 
   int stopped_by = 0;                              // the signal that ended the session early (physics thread)
+  // The step the current case ended at, -1 while it runs (physics writes, the telemetry service
+  // announces it once); whether it ended complete or out of time.
+  std::atomic<std::int64_t> case_over_step{-1};
+  std::atomic<bool> case_over_complete{false};
+  std::int64_t case_over_announced = -1;  // telemetry service
   runtime::Clock& physics_clock = lockstep && config.unpaced ? static_cast<runtime::Clock&>(unpaced_clock) : static_cast<runtime::Clock&>(wall);
   runtime::ThreadHarness harness(physics_clock, harness_config, [&](std::uint64_t k, double t_s) {
     const auto step = static_cast<std::int64_t>(k);
@@ -273,6 +282,7 @@ SessionSummary run_session(const SessionConfig& config) {
     if (std::unique_ptr<PreparedCase> ready = switcher.take()) {
       const int index = ready->index;
       model.stage(std::move(ready));
+      case_over_step.store(-1, std::memory_order_release);  // a new (or reset) case runs
       consume(case_input(index));
       if (switches < kMaxSwitchLog) switch_log[switches] = {k, index};
       ++switches;
@@ -305,6 +315,12 @@ SessionSummary run_session(const SessionConfig& config) {
     hub.take_new(consume);
     if (last) consume(session_end_marker(k + 1));
     const core::StepReport report = model.step();
+    // The end of the case: announced once (console and telemetry), with the score that now stands.
+    if (model.metrics().finished() && case_over_step.load(std::memory_order_relaxed) < 0) {
+      case_over_complete.store(model.metrics().completed(), std::memory_order_relaxed);
+      case_over_step.store(step, std::memory_order_release);
+      physics_out.push(score_item(model, step, true));
+    }
     // The model's metrics observed the step; running scores go out at a low rate (score() scans
     // the world), the final one with the last step.
     if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
@@ -349,6 +365,15 @@ SessionSummary run_session(const SessionConfig& config) {
   loop = &harness.loop();
   std::int64_t next_receive_status_ns = 0;
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
+    if (const std::int64_t over = case_over_step.load(std::memory_order_acquire); over >= 0 && over != case_over_announced) {
+      case_over_announced = over;
+      if (config.command_echo) {
+        std::fprintf(config.command_echo, "case over at step %lld: %s — the score stands; 'n' for the next case, 'r' to try it again\n",
+                     static_cast<long long>(over),
+                     case_over_complete.load(std::memory_order_relaxed) ? "every criterion met" : "its time limit passed");
+        std::fflush(config.command_echo);
+      }
+    }
     publisher.pump();
     publisher.handle_incoming();
     commands.pump_local();  // terminal commands in, physics' decisions back, acks out
@@ -447,6 +472,12 @@ SessionSummary run_session(const SessionConfig& config) {
     summary.recorder_dropped = recorder->dropped();
   }
   summary.score_lines = score_lines(model);
+  summary.case_finished = model.metrics().finished();
+  summary.case_completed = model.metrics().completed();
+  summary.case_finished_at_s = model.metrics().finished_at_s();
+  summary.criteria = model.metrics().criteria();
+  summary.score = model.metrics().score();
+  summary.totals = model.metrics().totals();
   for (std::size_t i = 0; i < hub.device_count(); ++i) {
     const auto& st = hub.stats(i);
     char line[512];

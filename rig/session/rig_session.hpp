@@ -97,6 +97,13 @@ struct SessionSummary {
   std::vector<std::string> score_lines;
   // Lockstep sessions: grants, handshake rounds, stalls and physics' wait for its inputs.
   std::string lockstep_line;
+  // The end of the case the session ended in (core/metrics: every criterion met, or its time limit
+  // passed): from then on its score stood. The structured final score, for tests and tools.
+  bool case_finished = false, case_completed = false;
+  double case_finished_at_s = 0.0;
+  std::vector<core::CriterionProgress> criteria;
+  core::ScoreCard score;
+  core::SessionTotals totals;
 };
 
 // Runs a live session to completion (config.steps) and returns its summary. Throws on setup errors

@@ -151,12 +151,14 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.to = *to;
         p.above_mm = w.number("above_mm", -10, 30).value_or(0);
         p.toward_port_mm = w.number("toward_port_mm", -15, 15).value_or(0);
+        p.across_mm = w.number("across_mm", -15, 15).value_or(0);
         p.offset_mm = w.vec3("offset_mm").value_or(Vec3::Zero());
         p.at_s = w.number("at_s", 0, 3600);
         p.speed_mm_s = w.number("speed_mm_s", 0.1, 100);
         p.duration_s = w.number("duration_s", 0, 600);
         p.hold_s = w.number("hold_s", 0, 600).value_or(0);
         p.jaws = w.number("jaws", 0, 1);
+        p.roll_deg = w.number("roll_deg", -360, 360);
         p.tool = w.string("tool");
         if (p.tool && h.tracker != kToolTracker) w.fail(*w.get("tool"), "tool", "only the working hand (tracker 0) switches tools");
         p.vacuum = w.number("vacuum", 0, 1);
@@ -164,7 +166,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.laser = w.boolean("laser");
         p.reflux = w.boolean("reflux");
         p.air = w.boolean("air");
-        w.refuse_unknown("to, above_mm, toward_port_mm, offset_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, tool, vacuum, cut_rate, laser, reflux, air");
+        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air");
         h.waypoints.push_back(std::move(p));
       }
       r.refuse_unknown("tracker, speed_mm_s, waypoint");
@@ -333,9 +335,33 @@ class LandmarkResolver {
   const SurgicalScript& s_;
 };
 
-std::string tracker_key(double t_ms, const Vec3& p, double jaws) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "key %.1f %.4f %.4f %.4f 0 0 0 %.3f\n", t_ms, p.x(), p.y(), p.z(), jaws);
+// The tracker's orientation for a twist `roll_deg` about the shaft from `port` to `tip`, as the Z-Y-X
+// Euler angles the emulator takes: the instrument's x axis at roll_deg from the eye's +z projected
+// across the shaft (rig/input/port_pivot.cpp measures it the same way), its z axis along the shaft.
+Vec3 euler_for_roll(const Vec3& port, const Vec3& tip, double roll_deg) {
+  Vec3 axis = tip - port;
+  if (axis.norm() < 1e-9) return Vec3::Zero();
+  axis.normalize();
+  Vec3 ref = Vec3::UnitZ() - Vec3::UnitZ().dot(axis) * axis;
+  if (ref.norm() < 1e-6) ref = Vec3::UnitX() - Vec3::UnitX().dot(axis) * axis;
+  ref.normalize();
+  const double r = roll_deg * kDeg;
+  const Vec3 x = std::cos(r) * ref + std::sin(r) * axis.cross(ref);
+  const Vec3 y = axis.cross(x);
+  Eigen::Matrix3d R;
+  R.col(0) = x;
+  R.col(1) = y;
+  R.col(2) = axis;
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  return Vec3(yaw, pitch, roll) / kDeg;
+}
+
+std::string tracker_key(double t_ms, const Vec3& p, double jaws, const Vec3& euler_deg = Vec3::Zero()) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "key %.1f %.4f %.4f %.4f %.3f %.3f %.3f %.3f\n", t_ms, p.x(), p.y(), p.z(), euler_deg.x(), euler_deg.y(),
+                euler_deg.z(), jaws);
   return buf;
 }
 
@@ -380,26 +406,31 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     const Port& port = c.tracker_ports[hand.tracker];
     Vec3 pos = port.position_mm + 2.0 * port.outward;  // the tip waits outside its cannula
     double jaws = 0.0, t = 0.0;
+    std::optional<double> roll;  // unset: the tracker's neutral orientation
     int tool = 0;
     std::string keys = tracker_key(0, pos, 0);
-    auto add_segment = [&](const Vec3& to, double to_jaws, double duration) {
+    auto orientation = [&](const Vec3& p, std::optional<double> r) { return r ? euler_for_roll(port.position_mm, p, *r) : Vec3::Zero(); };
+    auto add_segment = [&](const Vec3& to, double to_jaws, double duration, std::optional<double> to_roll) {
       // Tremor: seeded offsets at 20 Hz along the way (none while the hand is outside the eye).
       const int n = script.tremor_mm > 0.0 ? std::max(1, static_cast<int>(duration * 20.0)) : 1;
+      const std::optional<double> from_roll = roll ? roll : (to_roll ? std::optional<double>(0.0) : std::nullopt);
       for (int i = 1; i <= n; ++i) {
         const double f = static_cast<double>(i) / n;
         Vec3 p = pos + f * (to - pos);
         if (script.tremor_mm > 0.0 && i < n) p += script.tremor_mm * Vec3(tremor(rng), tremor(rng), tremor(rng));
-        keys += tracker_key((t + f * duration) * 1e3, p, jaws + f * (to_jaws - jaws));
+        const std::optional<double> r = to_roll ? std::optional<double>(*from_roll + f * (*to_roll - *from_roll)) : from_roll;
+        keys += tracker_key((t + f * duration) * 1e3, p, jaws + f * (to_jaws - jaws), orientation(p, r));
       }
       out.path_mm[hand.tracker] += (to - pos).norm();
       t += duration;
       pos = to;
       jaws = to_jaws;
+      if (to_roll) roll = to_roll;
     };
     for (std::size_t i = 0; i < hand.waypoints.size(); ++i) {
       const ScriptWaypoint& w = hand.waypoints[i];
       const std::string key = hand_key + ".waypoint[" + std::to_string(i) + "]";
-      if (w.at_s && *w.at_s > t) add_segment(pos, jaws, *w.at_s - t);  // wait in place
+      if (w.at_s && *w.at_s > t) add_segment(pos, jaws, *w.at_s - t, std::nullopt);  // wait in place
       PedalChange ch{t, w.vacuum, w.cut_rate, w.laser, w.reflux, w.air, 0, w.line};
       if (w.tool) {
         const auto it = std::find(tools.begin(), tools.end(), *w.tool);
@@ -408,17 +439,27 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
         ch.presses = (want - tool + static_cast<int>(tools.size())) % static_cast<int>(tools.size());
         tool = want;
         // a press takes 100 ms (down, up) and the hand waits for the switch
-        if (ch.presses > 0) add_segment(pos, jaws, 0.1 * ch.presses + 0.05);
+        if (ch.presses > 0) add_segment(pos, jaws, 0.1 * ch.presses + 0.05, std::nullopt);
       }
       if (ch.vacuum || ch.cut_rate || ch.laser || ch.reflux || ch.air || ch.presses) changes.push_back(ch);
-      const Landmark l = landmarks.resolve(w.to, hand.tracker, w.line, key + ".to");
+      Landmark l = landmarks.resolve(w.to, hand.tracker, w.line, key + ".to");
       Vec3 tangent_to_port = port.position_mm - l.at;
       tangent_to_port -= tangent_to_port.dot(l.inward) * l.inward;
       tangent_to_port = tangent_to_port.norm() > 1e-9 ? Vec3(tangent_to_port.normalized()) : Vec3::Zero();
+      if (w.to != "port" && (w.toward_port_mm != 0.0 || w.across_mm != 0.0)) {
+        // Along the fundus: step in the tangent plane, then back onto the curved wall at the
+        // landmark's own height above it (a raster over a membrane follows the globe's curve).
+        const Vec3 from_c = l.at - centre;
+        const double height = scene.eye.wall.radius_toward(from_c.normalized()) - from_c.norm();
+        const Vec3 moved = l.at + w.toward_port_mm * tangent_to_port + w.across_mm * l.inward.cross(tangent_to_port);
+        const Vec3 dir = (moved - centre).normalized();
+        l.at = centre + dir * (scene.eye.wall.radius_toward(dir) - height);
+        l.inward = -dir;
+      }
       // Pressing harder: every waypoint at or within 0.5 mm of tissue goes press_mm deeper.
       const bool touching = w.to != "port" && w.above_mm <= 0.5;
       const double above = w.above_mm - (touching ? script.press_mm : 0.0);
-      const Vec3 target = l.at + above * l.inward + w.toward_port_mm * tangent_to_port + w.offset_mm;
+      const Vec3 target = l.at + above * l.inward + w.offset_mm;
       // Reachable: inside the globe, and no farther from the port than a 32 mm shaft reaches.
       if (w.to != "port" || w.above_mm > 0.0) {
         const Vec3 d = target - centre;
@@ -429,8 +470,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       const double dist = (target - pos).norm();
       const double speed = w.speed_mm_s.value_or(hand.speed_mm_s) * script.speed_scale;
       const double duration = w.duration_s ? *w.duration_s / script.speed_scale : dist / speed;
-      add_segment(target, w.jaws.value_or(jaws), std::max(duration, 0.001));
-      if (w.hold_s > 0.0) add_segment(pos, jaws, w.hold_s / script.speed_scale);
+      add_segment(target, w.jaws.value_or(jaws), std::max(duration, 0.001), w.roll_deg);
+      if (w.hold_s > 0.0) add_segment(pos, jaws, w.hold_s / script.speed_scale, std::nullopt);
     }
     const std::string name = "tracker-" + std::to_string(hand.tracker);
     std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool 3\ninstrument " +

@@ -32,12 +32,14 @@ struct ScriptWaypoint {
   std::string to;             // landmark (see resolve_script)
   double above_mm = 0.0;      // along the landmark's inward normal (toward the globe centre); at a port, depth inside
   double toward_port_mm = 0.0;  // along the fundus toward the hand's port (a peel's direction)
+  double across_mm = 0.0;       // along the fundus at right angles to that (to the right, seen from inside)
   core::Vec3 offset_mm = core::Vec3::Zero();  // in the eye frame, on top
   std::optional<double> at_s;      // do not leave before this session time
   std::optional<double> speed_mm_s;  // default: the hand's speed
   std::optional<double> duration_s;  // instead of a speed
   double hold_s = 0.0;             // stay once there
   std::optional<double> jaws;      // 0 open .. 1 closed, reached on arrival
+  std::optional<double> roll_deg;  // twist about the shaft (0: handle up, as port_pivot measures it), reached on arrival
   std::optional<std::string> tool;  // working hand: select this tool (instrument-switch presses) before leaving
   // Pedals from this waypoint's start on (unset: unchanged).
   std::optional<double> vacuum;    // 0..1 of the vitrectomy pedal's travel

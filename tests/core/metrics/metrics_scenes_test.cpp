@@ -85,6 +85,8 @@ TEST_P(EveryCase, SettledStartHoldsEveryAttachment) {
   }
   std::printf("%s: %u attachments, %u broken while settling, largest force %.2f of its threshold\n", GetParam().c_str(),
               scene.world.attachment_count(), broken, worst);
+  for (const auto& m : scene.membranes)
+    std::printf("  membrane %s: %u attachments, %u strong\n", m.name.c_str(), m.attachment_count, m.strong_attachments);
   EXPECT_EQ(broken, 0u);
   EXPECT_LT(worst, 0.8);
 }
