@@ -148,6 +148,10 @@ CaseProgress::CaseProgress(const TissueWorld& world, MetricsCase c, ProgressOpti
       if (g.vertex_alive(v)) gel_start_.push_back(g.vertex_id(v));
     }
   }
+  // Membrane pieces that no attachment holds at the start (islands of a coarse mesh) are not the
+  // surgeon's work: membrane_freed counts from what was free then.
+  membrane_free_start_.assign(case_.membranes.size(), 0.0);
+  for (std::uint32_t m = 0; m < case_.membranes.size(); ++m) membrane_free_start_[m] = membrane_freed(world, m);
   if (case_.retina != kNone) {
     lift_start_mm_ = retina_lift_mm(world);
     const Surface& r = world.surface(case_.retina);
@@ -216,7 +220,10 @@ double CaseProgress::membrane_freed(const TissueWorld& world, std::uint32_t m) c
   for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
     if (s.triangle_alive(t) && held[root(s.triangle_vertices(t)[0])]) held_area += s.triangle_rest_area(t);
   }
-  return std::clamp(1.0 - held_area / start, 0.0, 1.0);
+  const double freed = std::clamp(1.0 - held_area / start, 0.0, 1.0);
+  if (m >= membrane_free_start_.size()) return freed;  // measuring the start itself
+  const double before = membrane_free_start_[m];
+  return before < 1.0 ? std::clamp((freed - before) / (1.0 - before), 0.0, 1.0) : 1.0;
 }
 
 double CaseProgress::path_cut_fraction(const TissueWorld& world, GuideSamples& g) const {

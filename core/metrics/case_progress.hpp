@@ -121,6 +121,7 @@ class CaseProgress {
   // Retina springs that were boundary edges at the start: generation per slot (kNone: not one).
   std::vector<std::uint32_t> boundary_start_;
   // membrane_freed's work space (sized to the membrane's vertex slots once, grown by cuts only).
+  std::vector<double> membrane_free_start_;  // membrane_freed's own value at the start, per membrane
   mutable std::vector<std::uint32_t> piece_parent_;
   mutable std::vector<std::uint8_t> piece_held_;
 };

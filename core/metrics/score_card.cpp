@@ -67,11 +67,13 @@ void compute_scores(const SessionTotals& t, const std::vector<CriterionProgress>
   if (goals) card.categories.push_back({"target_achievement", bounded(100.0 * progress), o.weight_target});
 
   // Efficiency: resources per unit of progress, so idling or stopping early is not efficient.
+  // Earned by the work like care below (× P): a hand that barely moves got half the path credit for
+  // free however little it achieved.
   double efficiency = 0.0;
   if (progress > 0.0) {
     const double t_half = time_limit_s > 0.0 ? time_limit_s : o.reference_time_s;
-    efficiency = 100.0 * (0.5 * half_credit(t.elapsed_s / progress, t_half) +
-                          0.5 * half_credit(t.path_length_mm / progress, o.reference_path_mm));
+    efficiency = 100.0 * progress *
+                 (0.5 * half_credit(t.elapsed_s / progress, t_half) + 0.5 * half_credit(t.path_length_mm / progress, o.reference_path_mm));
   }
   card.categories.push_back({"efficiency", bounded(efficiency), o.weight_efficiency});
 

@@ -14,6 +14,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "rig/session/surgical_script.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/snapshot.hpp"
 #include "rig/scene_io/scene_file.hpp"
@@ -58,6 +59,23 @@ int cmd_list(const std::string& dir) {
     try {
       const auto d = scene_io::load_scene_file(f);
       std::printf("%-34s %-8s %s\n", d.name.c_str(), d.category.c_str(), d.title.c_str());
+      // Its surgical scripts (scenes/scripts/CASE.KIND.toml), each parsed: a malformed one is listed as such.
+      const auto scripts = std::filesystem::path(dir) / "scripts";
+      std::vector<std::filesystem::path> found;
+      for (const auto& e : std::filesystem::directory_iterator(scripts, ec)) {
+        const std::string file = e.path().filename().string();
+        if (e.path().extension() == ".toml" && file.rfind(std::filesystem::path(f).stem().string() + ".", 0) == 0) found.push_back(e.path());
+      }
+      std::sort(found.begin(), found.end());
+      for (const auto& p : found) {
+        try {
+          const rig::SurgicalScript s = rig::read_surgical_script(p.string());
+          std::printf("    script %-7s %5.1f s  %s — %s\n", s.kind.c_str(), s.duration_s, p.filename().c_str(), s.summary.c_str());
+        } catch (const std::exception& e) {
+          std::printf("    script INVALID  %s\n", e.what());
+          ++bad;
+        }
+      }
     } catch (const scene_io::SceneError& e) {
       std::printf("%-34s INVALID  %s\n", std::filesystem::path(f).filename().c_str(), e.what());
       ++bad;
@@ -181,7 +199,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   std::string dir = "scenes";
-  auto* list = app.add_subcommand("list", "list the cases in a directory");
+  auto* list = app.add_subcommand("list", "list the cases in a directory, each with its surgical scripts (DIR/scripts)");
   list->add_option("--dir", dir, "directory of scene files")->capture_default_str();
 
   std::vector<std::string> files;

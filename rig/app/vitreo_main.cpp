@@ -25,7 +25,7 @@
 #include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/session/rig_session.hpp"
-#include "rig/session/surgical_script.hpp"
+#include "rig/session/scripted_session.hpp"
 
 #ifndef VITREO_SCENES_DIR
 #define VITREO_SCENES_DIR "scenes"
@@ -322,14 +322,7 @@ int main(int argc, char** argv) {
       }
     } else if (devices.empty()) {
       // The embedded default: the three devices simulated behind ptys.
-      devices = {{"tracker-0", DeviceRole::tracker, "sim:tracker?transport=pty", 1, 0, 0, 0, ""},
-                 {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, ""},
-                 {"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, 0, ""}};
-      // A script with a second hand (the light pipe) gets the second tracker.
-      for (const auto& h : script.hands) {
-        if (h.tracker == vitreo::rig::kLightPipeTracker)
-          devices.push_back({"tracker-1", DeviceRole::tracker, "sim:tracker?transport=pty", 4, vitreo::rig::kLightPipeTracker, 0, 0, ""});
-      }
+      devices = vitreo::rig::simulated_devices(script);  // a second tracker when the script has a second hand
     }
     config.devices = devices;
     // Lockstep wherever every device is simulated (a scripted session's outcome must not depend on
@@ -371,15 +364,7 @@ int main(int argc, char** argv) {
     }
     // Simulated devices without a script of their own play the surgical script, resolved against the
     // first case as loaded (its landmarks at its resolution).
-    config.adapt_devices = [&script, pedals = model.pedals](const vitreo::rig::PreparedCase& c, std::vector<vitreo::rig::DeviceSpec>& specs) {
-      const vitreo::rig::ResolvedScript resolved = vitreo::rig::resolve_script(script, c, pedals);
-      for (auto& d : specs) {
-        if (d.uri.rfind("sim:", 0) != 0 || !d.sim_script.empty()) continue;
-        const std::string name = d.role == DeviceRole::tracker ? "tracker-" + std::to_string(d.channel)
-                                 : d.role == DeviceRole::pedals ? "pedals" : "eyeball";
-        if (const auto it = resolved.device_scripts.find(name); it != resolved.device_scripts.end()) d.sim_script = it->second;
-      }
-    };
+    config.adapt_devices = vitreo::rig::play_script(script, model.pedals);
 
     static std::atomic<int> stop_signal{0};
     vitreo::app::install_stop_signals(stop_signal);

@@ -163,7 +163,9 @@ core::StepReport SimulationModel::step() {
       in.present = false;  // the tools not in the hand are outside the eye
     }
     in.pedal = std::clamp(vacuum, 0.0, 1.0);
-    in.trigger = c.laser_fire;
+    // The laser switch fires the tool in the working hand, nothing else (the light pipe's pick used
+    // to stick out at every shot).
+    in.trigger = static_cast<int>(i) == tool && c.laser_fire;
     in.light_power_mw = 5.0 + 10.0 * c.light_level;
     (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }

@@ -149,6 +149,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         const auto to = w.string("to");
         if (!to) w.fail_here("to", "missing: the landmark this waypoint goes to");
         p.to = *to;
+        p.to_line = line_of(*w.get("to"));
         p.above_mm = w.number("above_mm", -10, 30).value_or(0);
         p.toward_port_mm = w.number("toward_port_mm", -15, 15).value_or(0);
         p.across_mm = w.number("across_mm", -15, 15).value_or(0);
@@ -160,6 +161,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.jaws = w.number("jaws", 0, 1);
         p.roll_deg = w.number("roll_deg", -360, 360);
         p.tool = w.string("tool");
+        if (p.tool) p.tool_line = line_of(*w.get("tool"));
         if (p.tool && h.tracker != kToolTracker) w.fail(*w.get("tool"), "tool", "only the working hand (tracker 0) switches tools");
         p.vacuum = w.number("vacuum", 0, 1);
         p.cut_rate = w.number("cut_rate", 0, 1);
@@ -434,7 +436,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       PedalChange ch{t, w.vacuum, w.cut_rate, w.laser, w.reflux, w.air, 0, w.line};
       if (w.tool) {
         const auto it = std::find(tools.begin(), tools.end(), *w.tool);
-        if (it == tools.end()) landmarks.fail(w.line, key + ".tool", "the case offers no " + *w.tool + " to the working hand");
+        if (it == tools.end()) landmarks.fail(w.tool_line, key + ".tool", "the case offers no " + *w.tool + " to the working hand");
         const int want = static_cast<int>(it - tools.begin());
         ch.presses = (want - tool + static_cast<int>(tools.size())) % static_cast<int>(tools.size());
         tool = want;
@@ -442,7 +444,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
         if (ch.presses > 0) add_segment(pos, jaws, 0.1 * ch.presses + 0.05, std::nullopt);
       }
       if (ch.vacuum || ch.cut_rate || ch.laser || ch.reflux || ch.air || ch.presses) changes.push_back(ch);
-      Landmark l = landmarks.resolve(w.to, hand.tracker, w.line, key + ".to");
+      Landmark l = landmarks.resolve(w.to, hand.tracker, w.to_line, key + ".to");
       Vec3 tangent_to_port = port.position_mm - l.at;
       tangent_to_port -= tangent_to_port.dot(l.inward) * l.inward;
       tangent_to_port = tangent_to_port.norm() > 1e-9 ? Vec3(tangent_to_port.normalized()) : Vec3::Zero();
@@ -464,8 +466,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       if (w.to != "port" || w.above_mm > 0.0) {
         const Vec3 d = target - centre;
         const double wall_r = scene.eye.wall.radius_toward(d.normalized());
-        if (d.norm() > wall_r + 0.3) landmarks.fail(w.line, key, "unreachable: " + std::to_string(d.norm() - wall_r) + " mm beyond the eye wall");
-        if ((target - port.position_mm).norm() > 32.0) landmarks.fail(w.line, key, "unreachable: farther than a 32 mm shaft from the port");
+        if (d.norm() > wall_r + 0.3) landmarks.fail(w.to_line, key, "unreachable: " + std::to_string(d.norm() - wall_r) + " mm beyond the eye wall");
+        if ((target - port.position_mm).norm() > 32.0) landmarks.fail(w.to_line, key, "unreachable: farther than a 32 mm shaft from the port");
       }
       const double dist = (target - pos).norm();
       const double speed = w.speed_mm_s.value_or(hand.speed_mm_s) * script.speed_scale;

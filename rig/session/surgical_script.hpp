@@ -28,7 +28,8 @@ inline constexpr int kSurgicalScriptVersion = 1;
 
 // One waypoint of a hand: where the tip goes, how fast, what it does on the way and once there.
 struct ScriptWaypoint {
-  int line = 0;               // in the script file (diagnostics)
+  int line = 0;               // in the script file (diagnostics): the table's, its `to` and `tool` keys'
+  int to_line = 0, tool_line = 0;
   std::string to;             // landmark (see resolve_script)
   double above_mm = 0.0;      // along the landmark's inward normal (toward the globe centre); at a port, depth inside
   double toward_port_mm = 0.0;  // along the fundus toward the hand's port (a peel's direction)

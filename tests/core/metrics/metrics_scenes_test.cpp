@@ -1,7 +1,7 @@
 // Every shipped case (scenes/*.toml): its criteria are accepted by the metrics and measured at the
 // start — nothing removed, released, cut or lasered yet, the time limit met, scores in range.
 // The traction cases take ~5 s each to build (their membranes' subretinal-fluid regions), and their
-// criterion kinds (membrane_released, retina_flat) are met in other cases too: they run with
+// criterion kinds (membrane_freed, retina_flat) are met in other cases too: they run with
 // VITREO_LONG_TESTS=1.
 #include <gtest/gtest.h>
 
@@ -50,6 +50,7 @@ TEST_P(EveryCase, CriteriaAreMeasuredFromTheStart) {
       case CriterionKind::kGelRemoved:
       case CriterionKind::kMembraneRemoved:
       case CriterionKind::kMembraneReleased:
+      case CriterionKind::kMembraneFreed:
       case CriterionKind::kPathCut:
       case CriterionKind::kLaserCoverage:
         EXPECT_EQ(c.value, 0.0) << to_string(c.kind);

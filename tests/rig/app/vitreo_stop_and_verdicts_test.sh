@@ -13,7 +13,8 @@ rig=
 trap '[ -n "$rig" ] && kill -9 $rig 2>/dev/null; rm -rf "$tmp"' EXIT
 fail=0
 check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
-run() { exec "$vitreo" --no-render --cases "$scenes" --retina-vertices 1500 --cache "$tmp/cache" "$@"; }
+# The real-time path (the device reader on the wall clock, its starvation measured): --no-lockstep.
+run() { exec "$vitreo" --no-render --no-lockstep --cases "$scenes" --retina-vertices 1500 --cache "$tmp/cache" "$@"; }
 # Wait until the session's physics runs (its recording holds more than the header).
 wait_running() {
   for _ in $(seq 600); do

@@ -1,0 +1,170 @@
+// Every shipped case played by its scripted surgeons through the whole stack — firmware emulators →
+// ptys → drivers → rig → core → metrics, in lockstep — at the rig's resolution (5000 retina
+// vertices): the expert completes the case, the clumsy surgeon scores below the expert, an idle run
+// does not complete and scores at most 15 with no target achievement and no iatrogenic event
+// (issue 15's acceptance table). Cases whose expert script is not written yet are reported, not
+// passed. The margins are printed per category.
+//
+// And the lockstep's promise: the same script twice, the second time with the other cores busy, reaches
+// the same final state bit for bit.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rig/scene_io/case_loader.hpp"
+#include "rig/session/rig_session.hpp"
+#include "rig/session/scripted_session.hpp"
+
+namespace vitreo::rig {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kScenes = fs::path(VITREO_SOURCE_DIR) / "scenes";
+
+[[maybe_unused]] std::vector<std::string> case_names() {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(kScenes)) {
+    if (e.path().extension() == ".toml" && e.path().filename() != "materials.toml") out.push_back(e.path().stem().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+fs::path script_path(const std::string& case_name, const std::string& kind) {
+  return kScenes / "scripts" / (case_name + "." + kind + ".toml");
+}
+
+struct Played {
+  SessionSummary summary;
+  SurgicalScript script;
+};
+
+Played play(const std::string& case_name, const fs::path& script_file, const std::string& tag) {
+  Played out;
+  out.script = read_surgical_script(script_file.string());
+  const fs::path dir = fs::path(::testing::TempDir()) / ("scripted-" + case_name + "-" + tag);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  SessionConfig config;
+  config.model.cases.push_back(scene_io::read_case_text((kScenes / (case_name + ".toml")).string()));
+  config.model.load.retina_vertices = 5000;  // the rig's resolution on this 2-core machine
+  config.model.load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  config.devices = simulated_devices(out.script);
+  config.adapt_devices = play_script(out.script, config.model.pedals);
+  config.device_mode = HubMode::lockstep;
+  config.unpaced = true;
+  config.steps = static_cast<std::uint64_t>(std::llround(out.script.duration_s / config.model.dt_s));
+  config.lcm_url = "file://" + (dir / "telemetry.lcmlog").string() + "?mode=w";
+  config.command_echo = nullptr;
+  out.summary = run_session(config);
+  return out;
+}
+
+double category(const SessionSummary& s, const char* name) {
+  const core::ScoreEntry* e = s.score.find(name);
+  return e ? e->value : -1.0;
+}
+
+[[maybe_unused]] std::string line(const char* who, const SessionSummary& s) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%-7s total %5.1f  target %5.1f  efficiency %5.1f  tissue %5.1f  handling %5.1f  iatrogenic %u  %s",
+                who, s.score.total, category(s, "target_achievement"), category(s, "efficiency"), category(s, "tissue_treatment"),
+                category(s, "instrument_handling"), static_cast<unsigned>(s.totals.iatrogenic_events()),
+                s.case_completed ? "COMPLETED" : "not completed");
+  return buf;
+}
+
+#ifndef VITREO_LOCKSTEP_ONLY
+class ScriptedCase : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ScriptedCase, ExpertCompletesClumsyScoresLowerIdleScoresNothing) {
+  const std::string name = GetParam();
+  const bool have_expert = fs::exists(script_path(name, "expert"));
+  const bool have_clumsy = fs::exists(script_path(name, "clumsy"));
+  ASSERT_TRUE(fs::exists(script_path(name, "idle"))) << name << ": no idle script";
+
+  const Played idle = play(name, script_path(name, "idle"), "idle");
+  std::printf("%s\n  %s\n", name.c_str(), line("idle", idle.summary).c_str());
+  EXPECT_FALSE(idle.summary.case_completed);
+  EXPECT_LE(idle.summary.score.total, 15.0);
+  EXPECT_EQ(category(idle.summary, "target_achievement"), 0.0);
+  EXPECT_EQ(idle.summary.totals.iatrogenic_events(), 0u);
+  EXPECT_EQ(idle.summary.totals.retina_tears, 0u);
+
+  // A case nobody has written a completing expert for yet is reported as skipped (its idle run is
+  // still checked above): the list of open cases is in the test's output, never hidden in a pass.
+  if (!have_expert) GTEST_SKIP() << name << ": no expert script yet (" << script_path(name, "expert").string() << ")";
+  const Played expert = play(name, script_path(name, "expert"), "expert");
+  std::printf("  %s\n", line("expert", expert.summary).c_str());
+  EXPECT_TRUE(expert.summary.case_completed) << name << ": the expert script does not complete the case";
+  EXPECT_EQ(expert.summary.totals.retina_tears, 0u);
+  EXPECT_GT(expert.summary.score.total, idle.summary.score.total);
+
+  if (!have_clumsy) GTEST_SKIP() << name << ": the expert completes; no clumsy script yet";
+  const Played clumsy = play(name, script_path(name, "clumsy"), "clumsy");
+  std::printf("  %s\n", line("clumsy", clumsy.summary).c_str());
+  std::printf("  margins (expert − clumsy): total %+.1f", expert.summary.score.total - clumsy.summary.score.total);
+  for (const auto& e : expert.summary.score.categories) {
+    std::printf(", %s %+.1f", e.name, e.value - category(clumsy.summary, e.name));
+  }
+  std::printf("\n");
+  // A clumsy surgeon still completes the case unless its script says why it cannot ("does not
+  // complete: …" in its summary): there the gap to the expert must be plain.
+  if (clumsy.script.summary.find("does not complete") == std::string::npos) {
+    EXPECT_TRUE(clumsy.summary.case_completed) << name << ": the clumsy script should still complete the case";
+  } else {
+    EXPECT_FALSE(clumsy.summary.case_completed) << name << ": the clumsy script says it does not complete, but it does";
+    EXPECT_GT(expert.summary.score.total, clumsy.summary.score.total + 10.0);
+  }
+  EXPECT_LE(expert.summary.totals.iatrogenic_events(), clumsy.summary.totals.iatrogenic_events());
+  EXPECT_GT(expert.summary.score.total, clumsy.summary.score.total);
+  bool worse_somewhere = false;
+  for (const auto& e : expert.summary.score.categories) {
+    // The clumsy surgeon is below the expert where it is clumsy, and nowhere clearly better: a point
+    // is the scores' resolution (a category it does not aim at, like illumination with a light pipe
+    // nobody moves, may differ by a fraction).
+    EXPECT_GE(e.value + 1.0, category(clumsy.summary, e.name)) << name << ": the clumsy script beats the expert in " << e.name;
+    worse_somewhere = worse_somewhere || category(clumsy.summary, e.name) < e.value - 1.0;
+  }
+  EXPECT_TRUE(worse_somewhere) << name << ": the clumsy script is not clearly worse in any category";
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryCase, ScriptedCase, ::testing::ValuesIn(case_names()), [](const auto& p) { return p.param; });
+#else
+
+// Lockstep: a loaded machine slows a scripted session down but changes nothing it receives.
+TEST(Lockstep, SameScriptSameFinalStateWithTheCoresBusy) {
+  const std::string name = "exercise_pull_tissue";
+  const Played quiet = play(name, script_path(name, "expert"), "quiet");
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> burners;
+  // the other core busy (all but one on a bigger machine)
+  const unsigned n = std::max(1u, std::thread::hardware_concurrency() - 1);
+  for (unsigned i = 0; i < n; ++i) {
+    burners.emplace_back([&stop] {
+      volatile std::uint64_t x = 0;
+      while (!stop.load(std::memory_order_relaxed)) x = x + 1;
+    });
+  }
+  const Played busy = play(name, script_path(name, "expert"), "busy");
+  stop = true;
+  for (auto& t : burners) t.join();
+  std::printf("quiet: state %016llx, physics waited %s\nbusy:  state %016llx, physics waited %s\n",
+              static_cast<unsigned long long>(quiet.summary.state_hash), quiet.summary.lockstep_line.c_str(),
+              static_cast<unsigned long long>(busy.summary.state_hash), busy.summary.lockstep_line.c_str());
+  EXPECT_EQ(quiet.summary.state_hash, busy.summary.state_hash);
+  EXPECT_EQ(quiet.summary.score.total, busy.summary.score.total);
+  EXPECT_EQ(quiet.summary.inputs_applied, busy.summary.inputs_applied);
+}
+#endif
+
+}  // namespace
+}  // namespace vitreo::rig

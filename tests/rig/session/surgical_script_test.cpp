@@ -1,0 +1,159 @@
+// Surgical scripts (rig/session/surgical_script.hpp): every shipped script parses; malformed ones are
+// refused with FILE:LINE: KEY; resolving against a case refuses what the case lacks and what no
+// instrument can reach; the emulator keyframes land where the landmarks are, at the scripted speeds.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include "drivers/sim/emulator.hpp"
+#include "rig/scene_io/case_loader.hpp"
+#include "rig/session/surgical_script.hpp"
+
+namespace vitreo::rig {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kScenes = fs::path(VITREO_SOURCE_DIR) / "scenes";
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_surgical_script(text, "s.toml");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kHead = "[script]\nversion = 1\ncase = \"exercise_pull_tissue\"\nduration_s = 4.0\n";
+
+TEST(SurgicalScript, EveryShippedScriptParsesAndNamesAShippedCase) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(kScenes / "scripts")) {
+    if (e.path().extension() != ".toml") continue;
+    const SurgicalScript s = read_surgical_script(e.path().string());
+    EXPECT_TRUE(fs::exists(kScenes / (s.case_name + ".toml"))) << e.path();
+    EXPECT_EQ(e.path().filename().string().rfind(s.case_name + "." + s.kind + ".", 0), 0u) << e.path() << ": named CASE.KIND.toml";
+    if (s.kind == "idle") {
+      EXPECT_TRUE(s.hands.empty()) << e.path();
+    }
+    ++n;
+  }
+  EXPECT_GT(n, 0);
+}
+
+TEST(SurgicalScript, MalformedScriptsAreRefusedWithFileLineAndKey) {
+  EXPECT_NE(error_of("").find("s.toml:1: script: no [script] table"), std::string::npos) << error_of("");
+  EXPECT_NE(error_of("[script]\nversion = 2\ncase = \"x\"\n").find("s.toml:2: script.version: this is a version 2 script"), std::string::npos);
+  EXPECT_NE(error_of("[script]\nversion = 1\n").find("script.case: missing"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + "speed = 3\n").find("s.toml:5: script.speed: unknown key"), std::string::npos)
+      << error_of(std::string(kHead) + "speed = 3\n");
+  const std::string bad_key = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n[[hand.waypoint]]\nto = \"fovea\"\nspeeed_mm_s = 2\n";
+  EXPECT_NE(error_of(bad_key).find("s.toml:10: hand[0].waypoint[1].speeed_mm_s: unknown key"), std::string::npos) << error_of(bad_key);
+  const std::string bad_value = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\njaws = 1.5\n";
+  EXPECT_NE(error_of(bad_value).find("s.toml:8: hand[0].waypoint[0].jaws: 1.5"), std::string::npos) << error_of(bad_value);
+  const std::string wrong_type = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = 3\n";
+  EXPECT_NE(error_of(wrong_type).find("hand[0].waypoint[0].to: must be a non-empty string"), std::string::npos) << error_of(wrong_type);
+  const std::string light_tool = std::string(kHead) + "[[hand]]\ntracker = 1\n[[hand.waypoint]]\nto = \"port\"\ntool = \"forceps\"\n";
+  EXPECT_NE(error_of(light_tool).find("only the working hand"), std::string::npos) << error_of(light_tool);
+  const std::string two = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n";
+  EXPECT_NE(error_of(two).find("a second hand on tracker 0"), std::string::npos) << error_of(two);
+  const std::string fault = std::string(kHead) + "[[fault]]\ndevice = \"tracker-0\"\nkind = \"melt\"\nat_s = 1\n";
+  EXPECT_NE(error_of(fault).find("fault[0].kind: must be"), std::string::npos) << error_of(fault);
+  EXPECT_NE(error_of("[script\n").find("s.toml:1"), std::string::npos) << error_of("[script\n");
+}
+
+class Resolving : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    cases_.push_back(scene_io::read_case_text((kScenes / "exercise_pull_tissue.toml").string()));
+    scene_io::CaseLoadOptions o;
+    o.retina_vertices = 5000;
+    o.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+    case_ = prepare_case(cases_, 0, o).release();
+  }
+  static void TearDownTestSuite() { delete case_; }
+  static std::string resolve_error(const std::string& text) {
+    try {
+      (void)resolve_script(parse_surgical_script(text, "r.toml"), *case_, PedalMapping{});
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  }
+  static std::vector<scene_io::CaseText> cases_;
+  static PreparedCase* case_;
+};
+std::vector<scene_io::CaseText> Resolving::cases_;
+PreparedCase* Resolving::case_ = nullptr;
+
+TEST_F(Resolving, WhatTheCaseLacksOrNoInstrumentReachesIsRefusedAtLoad) {
+  const std::string tool = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\ntool = \"vitrector\"\n";
+  EXPECT_NE(resolve_error(tool).find("r.toml:8: hand[0].waypoint[0].tool: the case offers no vitrector"), std::string::npos) << resolve_error(tool);
+  const std::string membrane = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.erm.edge\"\n";
+  EXPECT_NE(resolve_error(membrane).find("the case has no membrane 'erm'"), std::string::npos) << resolve_error(membrane);
+  const std::string landmark = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"macula_hole\"\n";
+  EXPECT_NE(resolve_error(landmark).find("unknown landmark 'macula_hole'"), std::string::npos) << resolve_error(landmark);
+  const std::string beyond = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"fovea\"\nabove_mm = -2.0\n";
+  EXPECT_NE(resolve_error(beyond).find("r.toml:7: hand[0].waypoint[0]: unreachable"), std::string::npos) << resolve_error(beyond);
+  const std::string other = "[script]\nversion = 1\ncase = \"low_membrane_macula\"\n";
+  EXPECT_NE(resolve_error(other).find("not for 'exercise_pull_tissue'"), std::string::npos) << resolve_error(other);
+  EXPECT_EQ(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.patch.mid\"\nabove_mm = 1.0\n"), "");
+}
+
+TEST_F(Resolving, KeyframesLandOnTheLandmarksAtTheScriptedSpeeds) {
+  // In through the port to 3 mm deep at 10 mm/s, then to 1 mm above the fovea at 4 mm/s, closing the jaws.
+  const std::string text = std::string(kHead) +
+                           "[[hand]]\nspeed_mm_s = 10.0\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\n"
+                           "[[hand.waypoint]]\nto = \"fovea\"\nabove_mm = 1.0\nspeed_mm_s = 4.0\njaws = 1.0\n";
+  const ResolvedScript r = resolve_script(parse_surgical_script(text, "k.toml"), *case_, PedalMapping{});
+  drivers::sim::Script tracker;
+  std::string err;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("tracker-0"), tracker, &err)) << err;
+  ASSERT_EQ(tracker.keys.size(), 3u);
+  const Port& port = case_->tracker_ports[kToolTracker];
+  const core::Vec3 start = port.position_mm + 2.0 * port.outward;  // outside the cannula
+  const core::Vec3 inside = port.position_mm - 3.0 * port.outward;
+  const core::Scene& scene = *case_->scene;
+  const core::Vec3 inward = (scene.eye.wall.center() - scene.eye.fovea_mm).normalized();
+  const core::Vec3 over_fovea = scene.eye.fovea_mm + 1.0 * inward;
+  auto at = [&](std::size_t k) { return core::Vec3(tracker.keys[k].second[0], tracker.keys[k].second[1], tracker.keys[k].second[2]); };
+  EXPECT_NEAR((at(0) - start).norm(), 0.0, 1e-3);
+  EXPECT_NEAR((at(1) - inside).norm(), 0.0, 1e-3);
+  EXPECT_NEAR((at(2) - over_fovea).norm(), 0.0, 1e-3);
+  const double t1 = (inside - start).norm() / 10.0, t2 = t1 + (over_fovea - inside).norm() / 4.0;
+  EXPECT_NEAR(static_cast<double>(tracker.keys[1].first) * 1e-6, t1, 1e-3);
+  EXPECT_NEAR(static_cast<double>(tracker.keys[2].first) * 1e-6, t2, 1e-3);
+  EXPECT_DOUBLE_EQ(tracker.keys[2].second[6], 1.0);  // jaws closed on arrival
+  EXPECT_NEAR(r.path_mm[0], (inside - start).norm() + (over_fovea - inside).norm(), 1e-6);
+  // The pedals and the fixture play along, at rest.
+  drivers::sim::Script pedals;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("pedals"), pedals, &err)) << err;
+  for (const auto& k : pedals.keys) EXPECT_EQ(k.second[0], 0.0);
+}
+
+TEST_F(Resolving, PedalsAndToolSwitchesFollowTheWaypoints) {
+  // Select the pick (one instrument-switch press, bit 2 by default), vacuum 0.5 from the second waypoint.
+  const std::string text = std::string(kHead) +
+                           "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\ntool = \"pick\"\n"
+                           "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 4.0\nvacuum = 0.5\n";
+  const ResolvedScript r = resolve_script(parse_surgical_script(text, "p.toml"), *case_, PedalMapping{});
+  drivers::sim::Script pedals;
+  std::string err;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("pedals"), pedals, &err)) << err;
+  int presses = 0;
+  bool down = false;
+  double last_vacuum = 0.0;
+  for (const auto& k : pedals.keys) {
+    const bool pressed = (static_cast<unsigned>(k.second[2]) & (1u << PedalMapping{}.instrument_switch)) != 0;
+    if (pressed && !down) ++presses;
+    down = pressed;
+    last_vacuum = k.second[0];
+  }
+  EXPECT_EQ(presses, 1);
+  EXPECT_DOUBLE_EQ(last_vacuum, 0.5);
+}
+
+}  // namespace
+}  // namespace vitreo::rig
