@@ -104,6 +104,9 @@ struct InstrumentDescription {
 struct InstrumentSceneOptions {
   std::vector<Vec3> ports_mm;  // sclerotomies, eye frame
   std::uint32_t retina_surface = kNone;
+  // Tissue the endolaser's beam passes through: the vitreous gel is optically clear, so the beam
+  // burns the retina (its pigment epithelium) behind it; the gel neither stops nor takes a burn.
+  std::uint32_t vitreous_surface = kNone;
   std::optional<Vec3> macula_mm;
   std::vector<DrainageSite> drainage_sites;
   RigidAnatomy anatomy;

@@ -80,7 +80,9 @@ void InstrumentSystem::update_laser(InstrumentEvents& events) {
     if (st.description.kind != InstrumentKind::kEndolaser) continue;
     st.aim_hit = false;
     if (!st.inside) continue;
-    const RayHit hit = collision_->raycast(world_, st.frame.tip, st.frame.u, kLaserRange_mm);
+    std::uint32_t opaque = ~0u;
+    if (options_.vitreous_surface < 32) opaque &= ~(1u << options_.vitreous_surface);
+    const RayHit hit = collision_->raycast(world_, st.frame.tip, st.frame.u, kLaserRange_mm, opaque);
     st.aim_hit = hit.hit;
     st.aim_point_mm = hit.hit ? hit.point : Vec3(st.frame.tip + kLaserRange_mm * st.frame.u);
     const bool fire = st.input.trigger && !previous_input_[i].trigger;

@@ -165,6 +165,9 @@ void SceneDescription::validate() const {
     const auto& k = known_instruments();
     if (std::find(k.begin(), k.end(), i) == k.end()) throw InvalidArgument("instrument '" + i + "' is not known");
   }
+  if (working_port != "working_1" && working_port != "working_2") {
+    throw InvalidArgument("instruments.working_port '" + working_port + "' is not a working port (working_1, working_2)");
+  }
   std::set<std::string> tear_names;
   for (const auto& t : tears) tear_names.insert(t.name);
   for (const auto& g : guides) {

@@ -142,6 +142,10 @@ struct SceneDescription {
   std::vector<TearSpec> tears;
   std::vector<MembraneSpec> membranes;
   std::vector<std::string> instruments;
+  // The sclerotomy the working hand's instruments go through ("working_1" or "working_2"); the light
+  // pipe takes the other. A break on the same side as working_1 is reached across the eye from
+  // working_2, as a surgeon switches hands for it (the near port meets it at a grazing angle).
+  std::string working_port = "working_1";
   std::vector<GuideSpec> guides;
   std::vector<CriterionSpec> criteria;
   SettleSpec settle;

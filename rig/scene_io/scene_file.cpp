@@ -388,6 +388,8 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
   }
   if (auto t = root.table("instruments")) {
     d.instruments = t->strings("available");
+    t->string("working_port", d.working_port);
+    if (d.working_port != "working_1" && d.working_port != "working_2") t->fail("working_port", "expected \"working_1\" or \"working_2\"");
     t->finish();
     const auto& known = core::known_instruments();
     for (const auto& i : d.instruments) {

@@ -84,12 +84,18 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   const core::SclerotomyPort* w1 = find_port(s.eye, "working_1");
   const core::SclerotomyPort* w2 = find_port(s.eye, "working_2");
   if (!infusion || !w1 || !w2) throw core::InvalidArgument("case " + s.description.name + ": the eye has no three-port layout");
-  out->tracker_ports[kToolTracker] = pivot_of(*w1);
-  out->tracker_ports[kLightPipeTracker] = pivot_of(*w2);
+  const bool swapped = s.description.working_port == "working_2";
+  out->tracker_port_names[kToolTracker] = swapped ? "working_2" : "working_1";
+  out->tracker_port_names[kLightPipeTracker] = swapped ? "working_1" : "working_2";
+  out->tracker_port_ids[kToolTracker] = swapped ? 2 : 1;
+  out->tracker_port_ids[kLightPipeTracker] = swapped ? 1 : 2;
+  out->tracker_ports[kToolTracker] = pivot_of(swapped ? *w2 : *w1);
+  out->tracker_ports[kLightPipeTracker] = pivot_of(swapped ? *w1 : *w2);
 
   core::InstrumentSceneOptions o;
   o.ports_mm = {pivot_of(*infusion).position_mm, out->tracker_ports[0].position_mm, out->tracker_ports[1].position_mm};
   o.retina_surface = s.retina;
+  o.vitreous_surface = s.gel;
   o.macula_mm = s.eye.fovea_mm;
   o.anatomy.has_lens = true;
   o.anatomy.lens_center_mm = core::Vec3(0.0, 0.0, s.eye.lens_center_z_mm);
@@ -138,10 +144,10 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
 
 std::string describe_instruments(const PreparedCase& c) {
   std::ostringstream ss;
-  ss << "tracker 0 (working_1): ";
+  ss << "tracker 0 (" << c.tracker_port_names[kToolTracker] << "): ";
   for (std::size_t i = 0; i < c.tools.size(); ++i) ss << (i ? ", " : "") << core::to_string(c.tools[i]);
   if (c.tools.empty()) ss << "none";
-  ss << " (instrument switch cycles); tracker 1 (working_2): " << (c.light_pipe >= 0 ? "light pipe" : "none");
+  ss << " (instrument switch cycles); tracker 1 (" << c.tracker_port_names[kLightPipeTracker] << "): " << (c.light_pipe >= 0 ? "light pipe" : "none");
   return ss.str();
 }
 

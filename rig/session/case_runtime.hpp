@@ -8,9 +8,10 @@
 //
 // Tracker mapping (the surgeon's two hands):
 //   tracker instrument 0 → the hand-held tool: the case's instruments other than the light pipe and
-//                          the infusion, in the order the case lists them, through port "working_1";
+//                          the infusion, in the order the case lists them, through port "working_1"
+//                          (or "working_2" when the case's instruments.working_port says so);
 //                          the pedal's instrument-change switch cycles through them
-//   tracker instrument 1 → the light pipe through "working_2" (when no tracker drives it, it is held
+//   tracker instrument 1 → the light pipe through the other working port (when no tracker drives it, it is held
 //                          there aimed at the case's region of interest)
 #include <cstdint>
 #include <memory>
@@ -42,6 +43,8 @@ struct PreparedCase {
   std::vector<core::InstrumentKind> tools;  // simulation instruments 0..tools.size()-1
   int light_pipe = -1;                      // simulation instrument index of the light pipe (-1: none)
   Port tracker_ports[kTrackedInstruments];  // pivot of each tracked instrument
+  std::string tracker_port_names[kTrackedInstruments];  // the eye's port each goes through
+  int tracker_port_ids[kTrackedInstruments] = {1, 2};   // its index: 0 infusion, 1 working_1, 2 working_2
   core::Vec3 focus_mm = core::Vec3::Zero(); // the case's region of interest (light, microscope)
   std::uint64_t start_hash = 0;             // world state hash at the settled start
   bool from_cache = false;

@@ -103,7 +103,7 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
         ok = map_through_port(t.pose, case_->tracker_ports[t.instrument_id], core::Quat::Identity(), config_.calibration, pose);
         if (ok) {
           slot.present = true;
-          slot.port = t.instrument_id + 1;  // the eye's ports: 0 infusion, 1 working_1, 2 working_2
+          slot.port = case_->tracker_port_ids[t.instrument_id];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
           slot.tool_type = t.tool_type;
           slot.pose = pose;
         }

@@ -154,6 +154,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.toward_port_mm = w.number("toward_port_mm", -15, 15).value_or(0);
         p.across_mm = w.number("across_mm", -15, 15).value_or(0);
         p.offset_mm = w.vec3("offset_mm").value_or(Vec3::Zero());
+        p.standoff_mm = w.number("standoff_mm", 0, 30).value_or(0);
         p.at_s = w.number("at_s", 0, 3600);
         p.speed_mm_s = w.number("speed_mm_s", 0.1, 100);
         p.duration_s = w.number("duration_s", 0, 600);
@@ -168,7 +169,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.laser = w.boolean("laser");
         p.reflux = w.boolean("reflux");
         p.air = w.boolean("air");
-        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air");
+        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air");
         h.waypoints.push_back(std::move(p));
       }
       r.refuse_unknown("tracker, speed_mm_s, waypoint");
@@ -461,7 +462,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       // Pressing harder: every waypoint at or within 0.5 mm of tissue goes press_mm deeper.
       const bool touching = w.to != "port" && w.above_mm <= 0.5;
       const double above = w.above_mm - (touching ? script.press_mm : 0.0);
-      const Vec3 target = l.at + above * l.inward + w.offset_mm;
+      const Vec3 aimed = l.at + above * l.inward + w.offset_mm;
+      const Vec3 target = aimed - w.standoff_mm * (aimed - port.position_mm).normalized();
       // Reachable: inside the globe, and no farther from the port than a 32 mm shaft reaches.
       if (w.to != "port" || w.above_mm > 0.0) {
         const Vec3 d = target - centre;

@@ -35,6 +35,9 @@ struct ScriptWaypoint {
   double toward_port_mm = 0.0;  // along the fundus toward the hand's port (a peel's direction)
   double across_mm = 0.0;       // along the fundus at right angles to that (to the right, seen from inside)
   core::Vec3 offset_mm = core::Vec3::Zero();  // in the eye frame, on top
+  // Then this far back toward the hand's port along the line from the port through that point: the
+  // shaft points at it (an endolaser fires along its shaft, so its beam lands there).
+  double standoff_mm = 0.0;
   std::optional<double> at_s;      // do not leave before this session time
   std::optional<double> speed_mm_s;  // default: the hand's speed
   std::optional<double> duration_s;  // instead of a speed
@@ -50,7 +53,7 @@ struct ScriptWaypoint {
 
 struct ScriptHand {
   int line = 0;
-  int tracker = 0;  // 0: the working hand (tools, port working_1); 1: the other (light pipe, working_2)
+  int tracker = 0;  // 0: the working hand (tools, the case's working port); 1: the other (light pipe, the other port)
   double speed_mm_s = 5.0;
   std::vector<ScriptWaypoint> waypoints;
 };

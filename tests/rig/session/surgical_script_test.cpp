@@ -102,6 +102,49 @@ TEST_F(Resolving, WhatTheCaseLacksOrNoInstrumentReachesIsRefusedAtLoad) {
   EXPECT_EQ(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.patch.mid\"\nabove_mm = 1.0\n"), "");
 }
 
+TEST_F(Resolving, AStandoffPutsTheTipOnThePortLineShortOfItsPoint) {
+  // An endolaser aims along its shaft: 2 mm short of the fovea on the line from the port through it.
+  const std::string text = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"fovea\"\nstandoff_mm = 2.0\n";
+  const ResolvedScript r = resolve_script(parse_surgical_script(text, "s.toml"), *case_, PedalMapping{});
+  drivers::sim::Script tracker;
+  std::string err;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("tracker-0"), tracker, &err)) << err;
+  const core::Vec3 port = case_->tracker_ports[kToolTracker].position_mm;
+  const core::Vec3 fovea = case_->scene->eye.fovea_mm;
+  const core::Vec3 got(tracker.keys.back().second[0], tracker.keys.back().second[1], tracker.keys.back().second[2]);
+  EXPECT_NEAR((fovea - got).norm(), 2.0, 1e-3);
+  EXPECT_NEAR((got - port).norm() + 2.0, (fovea - port).norm(), 1e-3) << "on the segment from the port to the fovea";
+  EXPECT_NE(error_of(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"fovea\"\nstandoff_mm = -1.0\n").find("standoff_mm"), std::string::npos);
+}
+
+TEST_F(Resolving, ACaseCanPutTheWorkingHandThroughTheOtherPort) {
+  // instruments.working_port = "working_2": the tool's tracker pivots about the port the light pipe
+  // used, the light pipe's about the other, telemetry names the eye's ports, and a script's "port"
+  // landmark follows.
+  std::vector<scene_io::CaseText> swapped = cases_;
+  const auto at = swapped[0].text.find("[instruments]\n");
+  ASSERT_NE(at, std::string::npos);
+  swapped[0].text.insert(at + 14, "working_port = \"working_2\"\n");
+  scene_io::CaseLoadOptions o;
+  o.retina_vertices = 5000;
+  o.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
+  const auto c = prepare_case(swapped, 0, o);
+  EXPECT_NEAR((c->tracker_ports[kToolTracker].position_mm - case_->tracker_ports[kLightPipeTracker].position_mm).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((c->tracker_ports[kLightPipeTracker].position_mm - case_->tracker_ports[kToolTracker].position_mm).norm(), 0.0, 1e-12);
+  EXPECT_EQ(c->tracker_port_ids[kToolTracker], 2);
+  EXPECT_EQ(case_->tracker_port_ids[kToolTracker], 1);
+  EXPECT_NE(describe_instruments(*c).find("tracker 0 (working_2)"), std::string::npos) << describe_instruments(*c);
+  const std::string text = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\n";
+  const ResolvedScript r = resolve_script(parse_surgical_script(text, "w.toml"), *c, PedalMapping{});
+  drivers::sim::Script tracker;
+  std::string err;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("tracker-0"), tracker, &err)) << err;
+  const Port& p = c->tracker_ports[kToolTracker];
+  const core::Vec3 inside = p.position_mm - 3.0 * p.outward;
+  const core::Vec3 got(tracker.keys.back().second[0], tracker.keys.back().second[1], tracker.keys.back().second[2]);
+  EXPECT_NEAR((got - inside).norm(), 0.0, 1e-3);
+}
+
 TEST_F(Resolving, KeyframesLandOnTheLandmarksAtTheScriptedSpeeds) {
   // In through the port to 3 mm deep at 10 mm/s, then to 1 mm above the fovea at 4 mm/s, closing the jaws.
   const std::string text = std::string(kHead) +
