@@ -272,6 +272,37 @@ TEST(Instruments, LaserBurnIsCentredOnTheExactRayHit) {
   EXPECT_EQ(sys.burns().size(), 1u);
 }
 
+TEST(Instruments, TheLaserBeamPassesTheClearVitreousAndBurnsTheRetinaBehindIt) {
+  // A gel sheet 1 mm in front of the retina sheet: the beam crosses the gel (optically clear) and
+  // burns the retina where the ray meets z = 0; the gel takes no burn. Without the vitreous named,
+  // the first surface on the ray (the gel) is what the beam meets.
+  for (const bool clear : {true, false}) {
+    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+    world.add_surface(sheet(6.0, 13, 0.0));  // retina
+    world.add_surface(sheet(6.0, 13, 1.0));  // gel in front of it
+    anchor_border(world.surface(0), 6.0);
+    anchor_border(world.surface(1), 6.0);
+    InstrumentSceneOptions o;
+    o.ports_mm = {Vec3(3, 1, 8)};
+    o.retina_surface = 0;
+    if (clear) o.vitreous_surface = 1;
+    Simulation sys(world, o, {{InstrumentKind::kEndolaser, Gauge::k23, 0, {}}});
+    const Vec3 dir = Vec3(-0.37, -0.11, -1.0).normalized();
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], dir, 4.0);
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    in.trigger = true;
+    ASSERT_TRUE(sys.set_input(0, in));
+    sys.step(kDt);
+    ASSERT_EQ(sys.burns().size(), 1u);
+    const Vec3 o0 = in.tip_fixture_mm;
+    const double plane_z = clear ? 0.0 : 1.0;
+    const Vec3 analytic = o0 + ((plane_z - o0.z()) / dir.z()) * dir;
+    EXPECT_EQ(sys.burns()[0].surface, clear ? 0u : 1u);
+    EXPECT_LT((sys.burns()[0].position_mm - analytic).norm(), 0.010) << (clear ? "clear vitreous" : "vitreous not named");
+  }
+}
+
 TEST(Instruments, LaserAdheresAttachedRetinaOnlyAndBurnSizeFollowsEnergy) {
   RetinaCapOptions ro;
   ro.retina_vertices = 20000;
