@@ -126,6 +126,21 @@ CaseProgress::CaseProgress(const TissueWorld& world, MetricsCase c, ProgressOpti
         samples_.push_back(std::move(s));
         break;
       }
+      case CriterionKind::kTargetsReached: {
+        const std::uint32_t g = find(case_.guides, spec.target, "guide");
+        const Guide& guide = case_.guides[g];
+        if (guide.kind != GuideKind::kTarget) throw InvalidArgument("metrics: guide '" + guide.name + "' is the wrong kind for targets_reached");
+        if (guide.polyline_mm.empty()) throw InvalidArgument("metrics: guide '" + guide.name + "' has no targets");
+        GuideSamples s;
+        s.guide = g;
+        s.points = guide.polyline_mm;  // the targets themselves, in order
+        s.weights.assign(s.points.size(), 1.0);
+        s.covered.assign(s.points.size(), 0);
+        item = static_cast<std::uint32_t>(samples_.size());
+        target_samples_.push_back(item);
+        samples_.push_back(std::move(s));
+        break;
+      }
       case CriterionKind::kDrained:
         item = find(case_.detachments, spec.target, "detachment");
         start = world.local_force_scale(case_.detachments[item].local_force);
@@ -255,6 +270,26 @@ double CaseProgress::path_cut_fraction(const TissueWorld& world, GuideSamples& g
   return total > 0.0 ? covered / total : 0.0;
 }
 
+void CaseProgress::observe_tip(const TissueWorld& world, const Vec3& tip_mm) {
+  for (const std::uint32_t i : target_samples_) {
+    GuideSamples& g = samples_[i];
+    const auto next = static_cast<std::size_t>(std::find(g.covered.begin(), g.covered.end(), 0) - g.covered.begin());
+    if (next == g.points.size()) continue;
+    const Vec3& target = g.points[next];
+    // Height above the wall along the direction from the globe's centre (the target lies on it).
+    const Vec3 c = world.wall().center();
+    const Vec3 dir = (tip_mm - c).normalized();
+    const double height = world.wall().radius_toward(dir) - (tip_mm - c).norm();
+    if (tangential_distance(tip_mm, target, target) <= options_.target_reach_mm && height <= options_.target_hover_mm) g.covered[next] = 1;
+  }
+}
+
+double CaseProgress::reached_fraction(const GuideSamples& g) {
+  std::size_t n = 0;
+  while (n < g.covered.size() && g.covered[n]) ++n;
+  return g.covered.empty() ? 0.0 : static_cast<double>(n) / static_cast<double>(g.covered.size());
+}
+
 double CaseProgress::laser_fraction(const TissueWorld& world, const InstrumentSystem* instruments, GuideSamples& g) const {
   (void)world;
   std::fill(g.covered.begin(), g.covered.end(), 0);
@@ -300,6 +335,7 @@ void CaseProgress::evaluate(const TissueWorld& world, const InstrumentSystem* in
       case CriterionKind::kDrained: p.value = world.local_force_scale(case_.detachments[item].local_force); break;
       case CriterionKind::kRetinaFlat: p.value = retina_lift_mm(world); break;
       case CriterionKind::kTimeLimit: p.value = elapsed_s; break;
+      case CriterionKind::kTargetsReached: p.value = reached_fraction(samples_[item]); break;
     }
     switch (p.kind) {
       case CriterionKind::kDrained:

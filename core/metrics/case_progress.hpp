@@ -16,6 +16,9 @@
 //   drained            the detachment force's scale (≤ threshold)
 //   retina_flat        largest distance of a retina vertex from the wall, mm (≤ threshold)
 //   time_limit         elapsed simulated time, s (≤ threshold)
+//   targets_reached    fraction of a target guide's points reached in order: a working (not light
+//                      pipe) tip within target_reach_mm of the next target, tangentially, and at most
+//                      target_hover_mm above the wall there (observe_tip, every step)
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -55,6 +58,8 @@ struct MetricsCase {
 struct ProgressOptions {
   double path_tolerance_mm = 0.25;  // a guide point counts as cut when a new edge passes this close
   double sample_spacing_mm = 0.05;  // guides are measured at points this far apart along their arc
+  double target_reach_mm = 0.47;    // a target is reached by a tip this close along the wall (its drawn ring)…
+  double target_hover_mm = 1.0;     // …and at most this far above the wall
   void validate() const;            // throws InvalidArgument
 };
 
@@ -85,6 +90,9 @@ class CaseProgress {
   // Re-measures every criterion into criteria() (no allocation). instruments may be null (no
   // burns); elapsed_s is the case's simulated time.
   void evaluate(const TissueWorld& world, const InstrumentSystem* instruments, double elapsed_s);
+  // A working instrument's tip this step (targets_reached: the next target in order is reached when
+  // the tip is at it). Cheap; the session calls it every step for every working tip inside the eye.
+  void observe_tip(const TissueWorld& world, const Vec3& tip_mm);
   const std::vector<CriterionProgress>& criteria() const { return criteria_; }
 
   TissueProgress tissue(const TissueWorld& world) const;
@@ -105,6 +113,7 @@ class CaseProgress {
  private:
   double path_cut_fraction(const TissueWorld& world, GuideSamples& g) const;
   double laser_fraction(const TissueWorld& world, const InstrumentSystem* instruments, GuideSamples& g) const;
+  static double reached_fraction(const GuideSamples& g);
   double retina_lift_mm(const TissueWorld& world) const;
   double membrane_released(const TissueWorld& world, std::uint32_t m) const;
   double membrane_freed(const TissueWorld& world, std::uint32_t m) const;
@@ -114,6 +123,7 @@ class CaseProgress {
   std::vector<CriterionProgress> criteria_;
   std::vector<std::uint32_t> item_;          // per criterion: membrane / detachment / samples index
   std::vector<GuideSamples> samples_;
+  std::vector<std::uint32_t> target_samples_;  // samples_ of the targets_reached criteria (covered = reached)
   std::vector<VertexId> gel_start_;          // gel vertices at the start
   std::vector<double> membrane_area_start_;  // rest area per membrane at the start
   std::vector<double> scale_start_;          // per criterion (drained): the force scale at the start

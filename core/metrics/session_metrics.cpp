@@ -110,6 +110,8 @@ void SessionMetrics::accumulate(double dt) {
       last_tip_[i] = st.frame.tip;
     }
     was_inside_[i] = st.inside ? 1 : 0;
+    // Navigation targets are reached by a working tip (the light pipe only lights them).
+    if (st.inside && st.description.kind != InstrumentKind::kLightPipe) progress_.observe_tip(world_, st.frame.tip);
 
     const double f = st.retina_force_un;
     const bool touching = f > options_.contact_force_un;

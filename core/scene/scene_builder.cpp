@@ -433,6 +433,9 @@ Guide build_guide(const Scene& scene, const GuideSpec& g) {
       const double a = 2.0 * kPi * i / 64;
       out.polyline_mm.push_back(on_wall(eye, f, g.radius_mm * std::cos(a), g.radius_mm * std::sin(a)));
     }
+  } else if (g.kind == GuideKind::kTarget) {
+    // Targets are points, one per listed location, in order (no line between them).
+    for (const auto& p : g.points) out.polyline_mm.push_back(eye.wall_point(p.polar_deg * kDeg, p.azimuth_deg * kDeg));
   } else {
     for (std::size_t i = 0; i + 1 < g.points.size(); ++i) {
       const auto& a = g.points[i];

@@ -42,6 +42,7 @@ const char* to_string(CriterionKind k) {
     case CriterionKind::kMembraneRemoved: return "membrane_removed";
     case CriterionKind::kMembraneReleased: return "membrane_released";
     case CriterionKind::kMembraneFreed: return "membrane_freed";
+    case CriterionKind::kTargetsReached: return "targets_reached";
     case CriterionKind::kPathCut: return "path_cut";
     case CriterionKind::kLaserCoverage: return "laser_coverage";
     case CriterionKind::kDrained: return "drained";
@@ -177,7 +178,8 @@ void SceneDescription::validate() const {
       if (!g.around.empty() && !tear_names.count(g.around)) throw InvalidArgument("guide '" + g.name + "': no tear named '" + g.around + "'");
       if (g.around.empty()) location("guide '" + g.name + "'", g.center);
     } else {
-      if (g.points.size() < 2) throw InvalidArgument("guide '" + g.name + "': needs at least two points");
+      const std::size_t least = g.kind == GuideKind::kTarget ? 1 : 2;
+      if (g.points.size() < least) throw InvalidArgument("guide '" + g.name + "': needs at least " + (least == 1 ? "one point" : "two points"));
       for (const auto& p : g.points) location("guide '" + g.name + "'", p);
     }
   }
@@ -198,8 +200,13 @@ void SceneDescription::validate() const {
         break;
       case CriterionKind::kPathCut:
       case CriterionKind::kLaserCoverage:
+      case CriterionKind::kTargetsReached:
         if (std::none_of(guides.begin(), guides.end(), [&](const auto& g) { return g.name == c.target; })) {
           throw InvalidArgument(w + "no guide named '" + c.target + "'");
+        }
+        if (c.kind == CriterionKind::kTargetsReached &&
+            std::none_of(guides.begin(), guides.end(), [&](const auto& g) { return g.name == c.target && g.kind == GuideKind::kTarget; })) {
+          throw InvalidArgument(w + "guide '" + c.target + "' is not a target guide");
         }
         require_range(c.threshold, 0.0, 1.0, w + "threshold");
         break;

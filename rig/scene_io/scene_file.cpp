@@ -275,7 +275,7 @@ core::CriterionKind criterion_kind(Tab& t) {
   const std::string s = t.required_string("kind");
   using K = core::CriterionKind;
   for (K k : {K::kGelRemoved, K::kMembraneRemoved, K::kMembraneReleased, K::kMembraneFreed, K::kPathCut, K::kLaserCoverage, K::kDrained,
-              K::kRetinaFlat, K::kTimeLimit}) {
+              K::kRetinaFlat, K::kTimeLimit, K::kTargetsReached}) {
     if (s == core::to_string(k)) return k;
   }
   t.fail("kind", "unknown criterion '" + s + "'");

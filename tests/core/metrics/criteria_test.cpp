@@ -301,12 +301,57 @@ TEST(Criteria, DrainedRetinaFlatAndTimeLimit) {
   EXPECT_EQ(time.progress, 0.0);
 }
 
+TEST(Criteria, TargetsReachedCountsTheTargetsInTheirOrder) {
+  SceneDescription d = case_scene(false);
+  GuideSpec targets;
+  targets.name = "targets";
+  targets.kind = GuideKind::kTarget;
+  targets.points = {{20.0, 0.0}, {30.0, 90.0}, {25.0, 200.0}};
+  d.guides.push_back(targets);
+  d.criteria = {{CriterionKind::kTargetsReached, "targets", 1.0}};
+  Scene scene = build_scene(d, {false, false});
+  CaseProgress p(scene.world, MetricsCase::from_scene(scene));
+  // Reference positions from the eye's own mapping: the wall under each target, and heights along
+  // the direction from the globe's centre.
+  const Vec3 c = scene.world.wall().center();
+  auto above = [&](const FundusLocation& at, double height_mm, double sideways_mm = 0.0) {
+    const Vec3 w = scene.eye.wall_point(at.polar_deg * std::numbers::pi / 180.0, at.azimuth_deg * std::numbers::pi / 180.0);
+    const Vec3 in = (c - w).normalized();
+    const Vec3 side = in.cross(Vec3::UnitZ()).normalized();
+    return Vec3(w + height_mm * in + sideways_mm * side);
+  };
+  auto value = [&](double t) {
+    p.evaluate(scene.world, nullptr, t);
+    return p.criteria().front().value;
+  };
+  EXPECT_EQ(value(0.0), 0.0);
+  p.observe_tip(scene.world, above(targets.points[1], 0.5));  // out of turn: nothing
+  EXPECT_EQ(value(1.0), 0.0);
+  p.observe_tip(scene.world, above(targets.points[0], 0.8));
+  EXPECT_DOUBLE_EQ(value(2.0), 1.0 / 3.0);
+  p.observe_tip(scene.world, above(targets.points[1], 1.3));  // too high over it
+  EXPECT_DOUBLE_EQ(value(3.0), 1.0 / 3.0);
+  p.observe_tip(scene.world, above(targets.points[1], 0.9, 0.3));  // inside its ring, low enough
+  EXPECT_DOUBLE_EQ(value(4.0), 2.0 / 3.0);
+  p.observe_tip(scene.world, above(targets.points[2], 0.5, 0.6));  // beside its ring
+  EXPECT_DOUBLE_EQ(value(5.0), 2.0 / 3.0);
+  EXPECT_FALSE(p.criteria().front().met);
+  p.observe_tip(scene.world, above(targets.points[2], 0.2));
+  EXPECT_EQ(value(6.0), 1.0);
+  EXPECT_TRUE(p.criteria().front().met);
+  // The renderer's progress along the guide: every target reached.
+  ASSERT_EQ(p.guide_samples().size(), 1u);
+  EXPECT_EQ(p.guide_samples()[0].covered, std::vector<std::uint8_t>(3, 1));
+}
+
 TEST(Criteria, TargetsMustExistAndFitTheKind) {
   Scene scene = build();
   MetricsCase c = MetricsCase::from_scene(scene);
   c.criteria = {{CriterionKind::kLaserCoverage, "line", 0.5}};  // a cut path is not a laser ring
   EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);
   c.criteria = {{CriterionKind::kDrained, "nowhere", 0.5}};
+  EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);
+  c.criteria = {{CriterionKind::kTargetsReached, "line", 1.0}};  // a cut path has no targets
   EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);
   c.criteria = {{CriterionKind::kGelRemoved, "", 0.5}};  // this scene has no gel
   EXPECT_THROW(CaseProgress(scene.world, c), InvalidArgument);

@@ -53,6 +53,7 @@ TEST_P(EveryCase, CriteriaAreMeasuredFromTheStart) {
       case CriterionKind::kMembraneFreed:
       case CriterionKind::kPathCut:
       case CriterionKind::kLaserCoverage:
+      case CriterionKind::kTargetsReached:
         EXPECT_EQ(c.value, 0.0) << to_string(c.kind);
         EXPECT_FALSE(c.met) << to_string(c.kind);
         break;

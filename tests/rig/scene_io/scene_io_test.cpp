@@ -81,7 +81,7 @@ TEST(SceneFiles, CasesTheIssueAsksFor) {
   for (const char* n : {"rhegmatogenous_u_tear.toml", "traction_perpendicular.toml", "traction_circumferential.toml",
                         "traction_anteroposterior.toml", "low_membrane_macula.toml", "core_vitrectomy.toml",
                         "exercise_remove_gel.toml", "exercise_cut_path.toml", "exercise_pull_tissue.toml",
-                        "exercise_drain_tear.toml", "exercise_laser_tear.toml"}) {
+                        "exercise_drain_tear.toml", "exercise_laser_tear.toml", "exercise_navigation.toml"}) {
     EXPECT_NE(std::find(files.begin(), files.end(), n), files.end()) << n;
   }
   // Every material value has a source.
