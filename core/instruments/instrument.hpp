@@ -42,6 +42,9 @@ struct InstrumentInput {
   double twist_rad = 0.0;
   double actuation = 0.0;  // handle: 0 open .. 1 closed (forceps, scissors)
   double pedal = 0.0;      // 0..1: vitrector vacuum, needle aspiration, laser fire gate
+  // Vitrector: the console's cut rate (cuts per minute) set by the pedal; negative: the instrument's
+  // own VitrectorSettings::cut_rate_cpm. Clamped to its max_cut_rate_cpm.
+  double cut_rate_cpm = -1.0;
   bool trigger = false;    // light pipe: its pick is out; endolaser: fire a pulse on the rising edge
   double laser_power_mw = 200.0;
   double laser_duration_s = 0.1;

@@ -77,7 +77,7 @@ InstrumentSystem::~InstrumentSystem() = default;
 Status InstrumentSystem::set_input(std::uint32_t i, const InstrumentInput& in) {
   if (i >= state_.size()) return Status::error("set_input: no such instrument");
   if (!is_finite(in.tip_fixture_mm) || !is_finite(in.axis_fixture) || !(in.axis_fixture.norm() > 1e-9) ||
-      !std::isfinite(in.twist_rad) || !std::isfinite(in.actuation) || !std::isfinite(in.pedal) ||
+      !std::isfinite(in.twist_rad) || !std::isfinite(in.actuation) || !std::isfinite(in.pedal) || !std::isfinite(in.cut_rate_cpm) ||
       !std::isfinite(in.laser_power_mw) || !std::isfinite(in.laser_duration_s) || !std::isfinite(in.light_power_mw) ||
       in.laser_power_mw < 0.0 || in.laser_duration_s < 0.0 || in.light_power_mw < 0.0) {
     return Status::error("set_input: non-finite or negative value");

@@ -133,8 +133,8 @@ void InstrumentSystem::draw_in_and_sweep(double dt) {
       const double field = std::max(v.field_radius_mm * st.input.pedal, v.removal_radius_mm);
       suction_.push_back({st.tip.port_center, st.tip.port_normal, field, v.suction_pa * st.input.pedal});
       collision_->wake_near(world_, st.tip.port_center, field);
-      removals_.push_back({i, st.tip.port_center, st.tip.port_normal, v.removal_radius_mm, field, st.input.pedal,
-                           v.cut_rate_cpm, dt});
+      const double cut_rate = st.input.cut_rate_cpm >= 0.0 ? std::min(st.input.cut_rate_cpm, v.max_cut_rate_cpm) : v.cut_rate_cpm;
+      removals_.push_back({i, st.tip.port_center, st.tip.port_normal, v.removal_radius_mm, field, st.input.pedal, cut_rate, dt});
     }
     const bool blade = kind == InstrumentKind::kBlade || kind == InstrumentKind::kSidewaysBlade;
     const bool scissors = kind == InstrumentKind::kScissors && st.input.actuation > previous_input_[i].actuation;

@@ -163,6 +163,7 @@ core::StepReport SimulationModel::step() {
       in.present = false;  // the tools not in the hand are outside the eye
     }
     in.pedal = std::clamp(vacuum, 0.0, 1.0);
+    in.cut_rate_cpm = c.cut_rate_cpm;  // the vitrector's cutter, from the pedal (controls.hpp)
     // The laser switch fires the tool in the working hand, nothing else (the light pipe's pick used
     // to stick out at every shot).
     in.trigger = static_cast<int>(i) == tool && c.laser_fire;

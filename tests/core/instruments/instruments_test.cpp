@@ -852,6 +852,53 @@ TEST(Instruments, VitrectorRemovesOnlyAtItsPort) {
   }
 }
 
+TEST(Instruments, TheVitrectorCutsAtTheRateThePedalSets) {
+  // The same 200 ms at full suction with the cutter stopped (cut rate 0 from the pedal) removes
+  // nothing; at 600 cuts per minute the guillotine closes twice (at 100 and 200 ms), at the default
+  // 7500 cpm 25 times — each cut removing what has entered the port since the last.
+  auto run = [](double cut_rate_cpm, int& cuts) {
+    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+    SurfaceDescription dd = sheet(4.0, 40, 0.0);
+    dd.capacity.minimum_extra = 8192;
+    const std::uint32_t gel = world.add_surface(dd);
+    anchor_border(world.surface(gel), 4.0);
+    TopologyAdapter topology(world, {}, {gel});
+    InstrumentSceneOptions o;
+    o.ports_mm = {Vec3(-10, 0, 0.6)};
+    Simulation sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+    sys.set_topology(&topology);
+    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], Vec3::UnitX(), 10.0, std::numbers::pi);
+    in.pedal = 1.0;
+    in.cut_rate_cpm = cut_rate_cpm;
+    cuts = 0;
+    double removed = 0.0;
+    for (int i = 0; i < 200; ++i) {
+      EXPECT_TRUE(sys.set_input(0, in));
+      EXPECT_TRUE(sys.step(kDt).tissue.ok);
+      if (topology.removed_mass_g() > removed) ++cuts;  // a step whose cut took something
+      removed = topology.removed_mass_g();
+    }
+    return removed;
+  };
+  int cuts = 0;
+  EXPECT_EQ(run(0.0, cuts), 0.0);
+  EXPECT_EQ(cuts, 0);
+  EXPECT_GT(run(600.0, cuts), 0.0);
+  EXPECT_LE(cuts, 2);
+  EXPECT_GE(cuts, 1);
+  EXPECT_GT(run(7500.0, cuts), 0.0);
+  EXPECT_GT(cuts, 2);
+  EXPECT_LE(cuts, 25);
+  // Non-finite input is refused.
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(-10, 0, 0.6)};
+  Simulation sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+  InstrumentInput bad = InstrumentInput::through_port(o.ports_mm[0], Vec3::UnitX(), 10.0);
+  bad.cut_rate_cpm = std::nan("");
+  EXPECT_FALSE(sys.set_input(0, bad));
+}
+
 // The step's last stage is its observers: they see the step's final outputs (the tissue stepped,
 // the instruments' events of this step), once per step.
 TEST(Simulation, TheObserverRunsLastOncePerStep) {

@@ -3,7 +3,8 @@
 // vertices): the expert completes the case, the clumsy surgeon scores below the expert, an idle run
 // does not complete and scores at most 15 with no target achievement and no iatrogenic event
 // (issue 15's acceptance table). Cases whose expert script is not written yet are reported, not
-// passed. The margins are printed per category.
+// passed. The margins are printed per category. With VITREO_LONG_TESTS=1, a degradation sweep: the
+// expert scripts of three cases with a growing tremor score lower at every step.
 //
 // And the lockstep's promise: the same script twice, the second time with the other cores busy, reaches
 // the same final state bit for bit.
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -47,9 +49,12 @@ struct Played {
   SurgicalScript script;
 };
 
-Played play(const std::string& case_name, const fs::path& script_file, const std::string& tag) {
+// tremor_mm, when given, replaces the script's tremor σ: the degradation sweep plays the expert's
+// motions with a shakier hand.
+Played play(const std::string& case_name, const fs::path& script_file, const std::string& tag, double tremor_mm = -1.0) {
   Played out;
   out.script = read_surgical_script(script_file.string());
+  if (tremor_mm >= 0.0) out.script.tremor_mm = tremor_mm;
   const fs::path dir = fs::path(::testing::TempDir()) / ("scripted-" + case_name + "-" + tag);
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -138,6 +143,28 @@ TEST_P(ScriptedCase, ExpertCompletesClumsyScoresLowerIdleScoresNothing) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryCase, ScriptedCase, ::testing::ValuesIn(case_names()), [](const auto& p) { return p.param; });
+
+// The expert's script with a growing tremor (σ of the hand's position noise, 20 Hz): the score falls
+// at every step of the sweep. Four full sessions a case, so it runs with VITREO_LONG_TESTS=1.
+class DegradationSweep : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DegradationSweep, TheScoreFallsAsTheTremorGrows) {
+  if (!std::getenv("VITREO_LONG_TESTS")) GTEST_SKIP() << "four sessions a case; VITREO_LONG_TESTS=1";
+  const std::string name = GetParam();
+  double previous = 101.0;
+  for (const double tremor : {0.0, 0.1, 0.2, 0.4}) {
+    const Played p = play(name, script_path(name, "expert"), "tremor", tremor);
+    char who[32];
+    std::snprintf(who, sizeof who, "%.1fmm", tremor);
+    std::printf("%s tremor %s\n", name.c_str(), line(who, p.summary).c_str());
+    EXPECT_LT(p.summary.score.total, previous) << name << ": tremor " << tremor << " mm does not score below the steadier hand";
+    previous = p.summary.score.total;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ThreeCases, DegradationSweep,
+                         ::testing::Values("exercise_navigation", "exercise_laser_tear", "rhegmatogenous_u_tear"),
+                         [](const auto& p) { return p.param; });
 #else
 
 // Lockstep: a loaded machine slows a scripted session down but changes nothing it receives.
