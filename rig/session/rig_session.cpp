@@ -46,13 +46,21 @@ telemetry::Event to_event(const core::TissueEvent& e, std::int64_t step, double 
   return ev;
 }
 
-telemetry::InstrumentState to_state(const InstrumentSlot& slot, int id, std::int64_t step, double t_s) {
+// What the hand holds: the working hand's selected tool, the other hand's light pipe (core names).
+const char* held_instrument(const SimulationModel& model, std::size_t tracker) {
+  if (tracker == static_cast<std::size_t>(kLightPipeTracker)) return core::to_string(core::InstrumentKind::kLightPipe);
+  const int tool = model.selected_tool();
+  const auto& tools = model.current_case().tools;
+  return tool >= 0 && static_cast<std::size_t>(tool) < tools.size() ? core::to_string(tools[static_cast<std::size_t>(tool)]) : "none";
+}
+
+telemetry::InstrumentState to_state(const InstrumentSlot& slot, const char* held, int id, std::int64_t step, double t_s) {
   telemetry::InstrumentState st;
   st.step = step;
   st.t_s = t_s;
   st.instrument_id = static_cast<std::int8_t>(id);
   st.port_id = static_cast<std::int8_t>(slot.port);
-  std::snprintf(st.kind, sizeof st.kind, "tool-%d", slot.tool_type);
+  std::snprintf(st.kind, sizeof st.kind, "%s", held);
   for (int i = 0; i < 3; ++i) {
     st.tip_mm[i] = slot.pose.tip_mm[i];
     st.shaft_axis[i] = slot.pose.axis[i];
@@ -346,7 +354,7 @@ SessionSummary run_session(const SessionConfig& config) {
     if (k % 4 == 0) {  // instrument state at 250 Hz (CHANNELS.md)
       const auto& slots = model.instruments();
       for (std::size_t i = 0; i < slots.size(); ++i) {
-        if (slots[i].present) physics_out.push(to_state(slots[i], static_cast<int>(i), step, t_s));
+        if (slots[i].present) physics_out.push(to_state(slots[i], held_instrument(model, i), static_cast<int>(i), step, t_s));
       }
     }
     if (renderer && (k % view_every == 0 || last)) {

@@ -188,6 +188,10 @@ TEST(RigSession, ALostTrackerFreezesItsInstrumentAndTheSessionCarriesOn) {
       ASSERT_GE(s.decode(ev->data, 0, ev->datalen), 0);
       ++instrument_states;
       frozen_states += s.frozen ? 1 : 0;
+      // CHANNELS.md / instrument_state_t: what the hand holds and the eye's port it goes through
+      // (exercise_pull_tissue: the forceps first, through working_1; the light pipe through working_2).
+      EXPECT_EQ(s.kind, s.instrument_id == 0 ? "forceps" : "light pipe");
+      EXPECT_EQ(s.port_id, s.instrument_id == 0 ? 1 : 2);
       if (frozen_states > 0 && !s.frozen && s.instrument_id == 0) moving_after_frozen = true;
     }
   }
