@@ -13,6 +13,9 @@ packages=(
   liblcm-dev liblcm-bin
   libusb-1.0-0-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libpng-dev
+  # the session report (rig/report): Chart.js inlined into the page at build time; headless
+  # Chromium opens the page in its tests
+  libjs-chart.js chromium
   # recordings: the running CRC-32 of their checksum blocks
   zlib1g-dev
   # tests and benchmarks

@@ -1,0 +1,110 @@
+#include "rig/report/write_report.hpp"
+
+#include <algorithm>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "rig/report/report_html.hpp"
+#include "rig/report/report_json.hpp"
+#include "rig/report/session_log.hpp"
+
+namespace vitreo::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  return buf;
+}
+
+// The instructor frame of the latest step (frames are named step_%09d_instructor.png).
+fs::path last_instructor_frame(const fs::path& dir) {
+  fs::path best;
+  std::error_code ec;
+  if (!fs::is_directory(dir / "frames", ec)) return best;
+  for (const auto& e : fs::directory_iterator(dir / "frames", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("step_", 0) == 0 && name.size() > 15 && name.ends_with("_instructor.png") && e.is_regular_file(ec) &&
+        (best.empty() || name > best.filename().string()))
+      best = e.path();
+  }
+  return best;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + p.string());
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_atomically(const fs::path& p, const std::string& text) {
+  const fs::path tmp = p.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
+  }
+  std::error_code ec;
+  fs::rename(tmp, p, ec);
+  if (ec) throw std::runtime_error("cannot rename " + tmp.string() + " to " + p.string() + ": " + ec.message());
+}
+
+}  // namespace
+
+WrittenReport write_report(const std::string& session_dir, const ReportOptions& options) {
+  const fs::path dir(session_dir);
+  const fs::path log_path = options.telemetry_log.empty() ? dir / "telemetry.lcmlog" : fs::path(options.telemetry_log);
+  std::error_code ec;
+  if (!fs::exists(log_path, ec))
+    throw std::runtime_error("no telemetry log at " + log_path.string() + " (a session folder is what `vitreo --out DIR` wrote)");
+  const SessionLog log = read_session_log(log_path.string());
+  const std::string json = report_json(log);
+
+  PageInputs page;
+  page.report_json = json;
+  page.generated = options.generated.empty() ? utc_now() : options.generated;
+  std::string png;
+  if (const fs::path frame = last_instructor_frame(dir); !frame.empty()) {
+    png = read_file(frame);
+    page.final_png_name = "frames/" + frame.filename().string();
+  }
+  page.final_png = png;
+  const std::string html = report_html(page);
+
+  const fs::path out = options.out_dir.empty() ? dir : fs::path(options.out_dir);
+  fs::create_directories(out, ec);
+  WrittenReport r;
+  r.json_path = (out / "report.json").string();
+  r.html_path = (out / "report.html").string();
+  write_atomically(r.json_path, json);
+  write_atomically(r.html_path, html);
+
+  if (!log.notice.empty()) r.notices.push_back(log.notice);
+  if (log.messages_skipped > 0) r.notices.push_back(std::to_string(log.messages_skipped) + " messages did not decode");
+  const ScoreRecord* score = log.scores.empty() ? nullptr : &log.scores.back();
+  for (const auto& sc : log.scores)
+    if (sc.final_score) score = &sc;  // the last final card, as report.json takes it
+  if (score) {
+    r.case_id = score->case_id;
+    r.total = score->total;
+    r.final_score = score->final_score;
+  }
+  if (log.scores.empty()) r.notices.push_back("no score card in the log");
+  else if (!r.final_score) r.notices.push_back("no final score in the log: the numbers are the last running ones");
+  return r;
+}
+
+}  // namespace vitreo::report
