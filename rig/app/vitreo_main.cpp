@@ -24,6 +24,7 @@
 #include "rig/app/stop_signals.hpp"
 #include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/case_loader.hpp"
+#include "rig/report/write_report.hpp"
 #include "rig/session/rig_session.hpp"
 #include "rig/session/scripted_session.hpp"
 
@@ -419,6 +420,17 @@ int main(int argc, char** argv) {
     std::printf("  state hash       %016llx\n", static_cast<unsigned long long>(s.state_hash));
     std::fflush(stdout);
     sync_file(config.lcm_url);  // the telemetry log, when it is one (the recording synced itself)
+    // The debrief, from the telemetry log just written (rig/report): it never fails the session.
+    if (lcm_url.empty()) {
+      try {
+        const auto r = vitreo::report::write_report(out.string());
+        std::printf("  report           %s (numbers: %s)%s\n", r.html_path.c_str(), r.json_path.c_str(),
+                    r.notices.empty() ? "" : (" — " + r.notices.front()).c_str());
+      } catch (const std::exception& e) {
+        std::printf("  report           not written: %s\n", e.what());
+      }
+      std::fflush(stdout);
+    }
     if (verify_replay) {
       const auto r = vitreo::rig::replay_session(config.record_path, model);
       const bool complete = r.verdict == vitreo::telemetry::RecordingVerdict::Complete;

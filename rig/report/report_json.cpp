@@ -37,14 +37,14 @@ const char* event_kind_name(int kind) {
 // instrument_events.hpp), else by the telemetry kind (event_t.lcm).
 const char* event_unit(const EventRecord& e) {
   const std::string& w = e.what;
-  if (w == "excessive_retina_force" || w == "attachment_broken") return "uN";
+  if (w == "excessive_retina_force" || w == "attachment_broken" || w == "tissue_attachment_broken") return "uN";
   if (w == "unintended_tear") return "strain";
   if (w == "laser_burn") return "mm (burn diameter)";
   if (w == "light_too_close" || w == "laser_on_detached_retina" || w == "grasp") return "mm";
   if (w == "light_toxicity") return "J/cm2";
   if (w == "instrument_collision" || w == "lens_touch" || w == "wall_contact") return "mm (depth)";
-  if (w == "grasp_lost" || w == "grip_broken") return "uN";
-  if (w == "tear") return "strain";  // core TissueEvent: a tear's magnitude is the strain at which it tore
+  if (w == "grasp_lost" || w == "tissue_grip_broken") return "uN";
+  if (w == "tissue_tear") return "strain";  // core TissueEvent: a tear's magnitude is the strain at which it tore
   switch (e.kind) {
     case 1: return "mN";
     case 2: case 3: return "mm";

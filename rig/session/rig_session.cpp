@@ -44,9 +44,10 @@ telemetry::Event to_event(const core::TissueEvent& e, std::int64_t step, double 
   ev.tissue_id = static_cast<std::int32_t>(e.surface);
   for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
   ev.magnitude = e.magnitude;
-  telemetry::copy_text(ev.what, e.kind == core::TissueEventKind::kTear           ? "tear"
-                                : e.kind == core::TissueEventKind::kGripBroken ? "grip_broken"
-                                                                                : "attachment_broken");
+  // Prefixed: the instruments pass a broken attachment on as their own event too (event_keys.hpp).
+  telemetry::copy_text(ev.what, e.kind == core::TissueEventKind::kTear           ? "tissue_tear"
+                                : e.kind == core::TissueEventKind::kGripBroken ? "tissue_grip_broken"
+                                                                                : "tissue_attachment_broken");
   return ev;
 }
 
