@@ -6,14 +6,14 @@
 # look at, and compared with the checked-in golden (tests/rig/report/golden/) with a tolerance when
 # one is given.
 set -euo pipefail
-report=$1 session=$2 shots=$3 golden=${4:-}
+report=$1 session=$2 shots=$3 compare=${4:-} golden=${5:-}
 command -v chromium > /dev/null || { echo "chromium is not installed (tools/install-deps.sh)"; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$report" "$session" --out "$work" --generated "2026-01-01 00:00:00 UTC" > /dev/null
 flags=(--headless --no-sandbox --disable-gpu --no-first-run --user-data-dir="$work/profile" --disable-extensions
        --proxy-server=127.0.0.1:9 --proxy-bypass-list='<-loopback>' --hide-scrollbars --force-device-scale-factor=1
-       --enable-logging=stderr --v=0 --virtual-time-budget=5000)
+       --enable-logging=stderr --v=0 --virtual-time-budget=1000)
 timeout 60 chromium "${flags[@]}" --dump-dom "file://$work/report.html" > "$work/dom.html" 2> "$work/console.txt"
 
 fail=0
@@ -34,9 +34,10 @@ grep -q 'id="final-fundus" alt="final fundus" src="data:image/png;base64,' "$wor
 [ "$fail" -eq 0 ] || exit 1
 
 mkdir -p "$shots"
-timeout 60 chromium "${flags[@]}" --window-size=1400,1800 --screenshot="$shots/report.png" "file://$work/report.html" 2> /dev/null > /dev/null
+timeout 60 chromium "${flags[@]}" --window-size=1200,2100 --screenshot="$shots/report.png" "file://$work/report.html" 2> /dev/null > /dev/null
 test -s "$shots/report.png"
 echo "screenshot: $shots/report.png"
 if [ -n "$golden" ]; then
-  python3 "$(dirname "$0")/compare_png.py" "$golden" "$shots/report.png"
+  # The top of the page: score, criteria, score card, the fundus paths and the final fundus.
+  "$compare" "$golden" "$shots/report.png"
 fi
