@@ -1,7 +1,8 @@
 // vitreo-report: the debrief of a session. Reads the session folder the main job wrote
 // (`vitreo --out DIR`): its telemetry log and its last instructor frame, and writes DIR/report.json
 // (every number with its unit and the formulas' version) and DIR/report.html (one self-contained
-// page: criteria, score card, tip paths over the fundus, timelines, the final fundus).
+// page: criteria, score card, tip paths over the fundus, timelines, the final fundus); with
+// --compare OTHER also DIR/compare.html, this session against another side by side.
 //
 // Exit status: 0 report written from a complete log; 3 written, but the log was truncated or
 // corrupted, or has no final score (the page and the JSON say so); 1 no report (the reason is printed).
@@ -18,6 +19,9 @@ int main(int argc, char** argv) {
   app.add_option("DIR", dir, "session folder (what `vitreo --out DIR` wrote)")->required();
   app.add_option("--log", options.telemetry_log, "telemetry log to read instead of DIR/telemetry.lcmlog");
   app.add_option("--out", options.out_dir, "folder to write report.json and report.html into (default: DIR)");
+  app.add_option("--compare", options.compare_dir,
+                 "another session folder (e.g. the expert script's run of the same case): also writes compare.html, "
+                 "this session against that one side by side");
   app.add_option("--generated", options.generated, "the generation time shown on the page (default: now, UTC)");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -26,6 +30,7 @@ int main(int argc, char** argv) {
                 r.final_score ? "final" : "not final");
     for (const auto& n : r.notices) std::printf("  notice: %s\n", n.c_str());
     std::printf("  %s\n  %s\n", r.json_path.c_str(), r.html_path.c_str());
+    if (!r.compare_path.empty()) std::printf("  %s (against %s)\n", r.compare_path.c_str(), options.compare_dir.c_str());
     return r.notices.empty() ? 0 : 3;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vitreo-report: %s\n", e.what());

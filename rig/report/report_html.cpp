@@ -45,7 +45,10 @@ std::string report_html(const PageInputs& in) {
   fill(page, "@GENERATED@", html_text(in.generated));
   fill(page, "@FUNDUS_NAME@", html_text(in.final_png_name.empty() ? "no instructor frame in the session folder" : in.final_png_name));
   fill(page, "@FUNDUS_SRC@", in.final_png.empty() ? std::string() : "data:image/png;base64," + base64_encode(in.final_png));
+  fill(page, "@COMPARE_LABEL@", html_text(in.compare_label));
+  fill(page, "@COMPARE_FUNDUS_SRC@", in.compare_png.empty() ? std::string() : "data:image/png;base64," + base64_encode(in.compare_png));
   fill(page, "/*@CHARTJS@*/", assets::chartjs());
+  fill(page, "/*@COMPARE_JSON@*/", in.compare_json.empty() ? std::string_view("null") : in.compare_json);
   fill(page, "/*@REPORT_JSON@*/", in.report_json);  // last: nothing is searched in the data
   return page;
 }

@@ -11,6 +11,10 @@ struct PageInputs {
   std::string_view final_png;      // the last instructor frame's PNG bytes, empty when there is none
   std::string final_png_name;      // its file name (shown under the picture)
   std::string generated;           // when the page was made (the only thing that differs between two runs)
+  // Another session's report_json() to show side by side (empty: a report of one session).
+  std::string_view compare_json;
+  std::string compare_label;       // what to call it on the page (its folder)
+  std::string_view compare_png;    // its last instructor frame
 };
 
 std::string report_html(const PageInputs& in);

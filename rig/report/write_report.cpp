@@ -91,6 +91,20 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
   r.html_path = (out / "report.html").string();
   write_atomically(r.json_path, json);
   write_atomically(r.html_path, html);
+  if (!options.compare_dir.empty()) {
+    const fs::path other = fs::path(options.compare_dir) / "telemetry.lcmlog";
+    if (!fs::exists(other, ec)) throw std::runtime_error("--compare: no telemetry log at " + other.string());
+    const SessionLog other_log = read_session_log(other.string());
+    const std::string other_json = report_json(other_log);
+    page.compare_json = other_json;
+    page.compare_label = fs::path(options.compare_dir).lexically_normal().string();
+    std::string other_png;
+    if (const fs::path frame = last_instructor_frame(options.compare_dir); !frame.empty()) other_png = read_file(frame);
+    page.compare_png = other_png;
+    r.compare_path = (out / "compare.html").string();
+    write_atomically(r.compare_path, report_html(page));
+    if (!other_log.notice.empty()) r.notices.push_back("compared session: " + other_log.notice);
+  }
 
   if (!log.notice.empty()) r.notices.push_back(log.notice);
   if (log.messages_skipped > 0) r.notices.push_back(std::to_string(log.messages_skipped) + " messages did not decode");

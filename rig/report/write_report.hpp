@@ -9,6 +9,7 @@ namespace vitreo::report {
 
 struct WrittenReport {
   std::string json_path, html_path;
+  std::string compare_path;          // compare.html, when another session was given
   std::vector<std::string> notices;  // what the report says is missing or wrong in the log
   std::string case_id;
   double total = 0;
@@ -19,6 +20,9 @@ struct ReportOptions {
   std::string telemetry_log;  // default: DIR/telemetry.lcmlog
   std::string out_dir;        // default: DIR
   std::string generated;      // the page's generation time; default: now (UTC)
+  // Another session folder (e.g. the case's expert script run) to show side by side: also writes
+  // OUT/compare.html, this session (A) against that one (B).
+  std::string compare_dir;
 };
 
 // Throws std::runtime_error with a reason an instructor can act on (no log, nothing readable,
