@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
     const auto r = vitreo::report::write_report(dir, options);
     std::printf("report: %s — %.1f / 100 (%s)\n", r.case_id.empty() ? "unknown case" : r.case_id.c_str(), r.total,
                 r.final_score ? "final" : "not final");
+    if (r.survey_rating > 0) std::printf("  survey: modified Cooper-Harper rating %.1f of 10\n", r.survey_rating);
     for (const auto& n : r.notices) std::printf("  notice: %s\n", n.c_str());
     std::printf("  %s\n  %s\n", r.json_path.c_str(), r.html_path.c_str());
     if (!r.compare_path.empty()) std::printf("  %s (against %s)\n", r.compare_path.c_str(), options.compare_dir.c_str());

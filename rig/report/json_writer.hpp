@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -43,6 +44,7 @@ class JsonWriter {
   JsonWriter& value(bool v) { value_prefix(); out_ += v ? "true" : "false"; return *this; }
   JsonWriter& value(std::string_view s) { value_prefix(); string_literal(s); return *this; }
   JsonWriter& value(const char* s) { return value(std::string_view(s)); }
+  JsonWriter& value(std::nullptr_t) { value_prefix(); out_ += "null"; return *this; }
   // A measured number with its unit: {"value": v, "unit": u}.
   JsonWriter& measure(double v, std::string_view unit) {  // on one line
     value_prefix();

@@ -213,7 +213,7 @@ void write_array(JsonWriter& j, const std::vector<double>& v, const std::vector<
 
 }  // namespace
 
-std::string report_json(const SessionLog& log) {
+std::string report_json(const SessionLog& log, const Survey* survey, const std::string& survey_problem) {
   JsonWriter j;
   const ScoreRecord* score = final_or_last(log.scores);
   const CriteriaRecord* criteria = final_or_last(log.criteria);
@@ -228,6 +228,7 @@ std::string report_json(const SessionLog& log) {
   else if (!score->final_score)
     notices.push_back("no final score in the log: the session did not end normally; the numbers are the last running ones, at step " +
                       std::to_string(score->step));
+  if (!survey_problem.empty()) notices.push_back("survey.json not shown: " + survey_problem);
   if (totals && totals->formula_version != core::kScoreFormulaVersion)
     notices.push_back("the session scored with formulas version " + std::to_string(totals->formula_version) + "; this report knows version " +
                       std::to_string(core::kScoreFormulaVersion) + " (the inputs' recomputation is not comparable)");
@@ -471,6 +472,37 @@ std::string report_json(const SessionLog& log) {
     j.end_object();
   }
   j.end_array();
+
+  // The post-session survey (Appendix C of the thesis), when the folder has one.
+  if (survey) {
+    const Survey& v = *survey;
+    j.key("survey").begin_object();
+    j.key("format").value(kSurveyFormat);
+    j.key("subject").value(v.subject);
+    j.key("date").value(v.date);
+    j.field("cooper_harper_rating", v.rating, "modified Cooper-Harper (1 very easy .. 10 impossible)");
+    j.key("rating_text").value(v.rating_text);
+    j.key("accomplished").value(v.accomplished);
+    if (v.errors_small) j.key("errors_small").value(*v.errors_small);
+    if (v.workload_acceptable) j.key("workload_acceptable").value(*v.workload_acceptable);
+    j.key("page").value(v.page);
+    j.key("level").value(v.level);
+    j.key("categories").begin_object();
+    for (const auto& [k, level] : v.categories) j.key(k).value(level);
+    j.end_object();
+    j.key("instruments").begin_object();
+    for (const auto& [k, r] : v.instruments) {
+      j.key(k).begin_object();
+      j.key("rating").value(r.rating);
+      j.key("comment").value(r.comment);
+      j.end_object();
+    }
+    j.end_object();
+    j.key("comments").value(v.comments);
+    j.end_object();
+  } else {
+    j.key("survey").value(nullptr);
+  }
   j.end_object();
   std::string out = j.take();
   out += '\n';

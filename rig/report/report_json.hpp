@@ -6,11 +6,14 @@
 #include <string>
 
 #include "rig/report/session_log.hpp"
+#include "rig/report/survey.hpp"
 
 namespace vitreo::report {
 
 inline constexpr int kReportFormat = 1;  // the layout of report.json (README)
 
-std::string report_json(const SessionLog& log);
+// survey: the session's post-session evaluation (DIR/survey.json), or null; survey_problem: why the
+// one in the folder was refused (a notice), empty when there was none or it was read.
+std::string report_json(const SessionLog& log, const Survey* survey = nullptr, const std::string& survey_problem = "");
 
 }  // namespace vitreo::report

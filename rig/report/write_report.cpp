@@ -4,12 +4,14 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "rig/report/report_html.hpp"
 #include "rig/report/report_json.hpp"
 #include "rig/report/session_log.hpp"
+#include "rig/report/survey.hpp"
 
 namespace vitreo::report {
 
@@ -71,7 +73,17 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
   if (!fs::exists(log_path, ec))
     throw std::runtime_error("no telemetry log at " + log_path.string() + " (a session folder is what `vitreo --out DIR` wrote)");
   const SessionLog log = read_session_log(log_path.string());
-  const std::string json = report_json(log);
+  // The survey filled in after the session (the page's form saves it as DIR/survey.json).
+  std::optional<Survey> survey;
+  std::string survey_problem;
+  if (const fs::path sp = dir / "survey.json"; fs::exists(sp, ec)) {
+    try {
+      survey = parse_survey(read_file(sp));
+    } catch (const std::exception& e) {
+      survey_problem = e.what();
+    }
+  }
+  const std::string json = report_json(log, survey ? &*survey : nullptr, survey_problem);
 
   PageInputs page;
   page.report_json = json;
@@ -107,6 +119,8 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
   }
 
   if (!log.notice.empty()) r.notices.push_back(log.notice);
+  if (!survey_problem.empty()) r.notices.push_back("survey.json not shown: " + survey_problem);
+  if (survey) r.survey_rating = survey->rating;
   if (log.messages_skipped > 0) r.notices.push_back(std::to_string(log.messages_skipped) + " messages did not decode");
   const ScoreRecord* score = log.scores.empty() ? nullptr : &log.scores.back();
   for (const auto& sc : log.scores)

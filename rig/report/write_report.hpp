@@ -14,6 +14,7 @@ struct WrittenReport {
   std::string case_id;
   double total = 0;
   bool final_score = false;
+  double survey_rating = 0;          // the survey's modified Cooper-Harper rating, 0 without a survey
 };
 
 struct ReportOptions {

@@ -10,7 +10,19 @@ report=$1 session=$2 shots=$3 compare=${4:-} golden=${5:-}
 command -v chromium > /dev/null || { echo "chromium is not installed (tools/install-deps.sh)"; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-"$report" "$session" --out "$work" --generated "2026-01-01 00:00:00 UTC" > /dev/null
+# The session's log and a survey as the page's form writes it (survey_test.sh checks its numbers).
+cp "$session/telemetry.lcmlog" "$work/"
+cp -r "$session/frames" "$work/"
+cat > "$work/survey.json" <<'JSON'
+{
+  "format": "vitreo-survey-1", "subject": "fellow-07", "date": "2026-11-26",
+  "accomplished": true, "errors_small": true, "workload_acceptable": false, "level": "medium",
+  "categories": {"tracking": "somewhat_high", "physical_interface": "medium", "instrumentation": "low"},
+  "instruments": {"forceps": {"rating": "very_good", "comment": "jaws <b>grip</b> well"}},
+  "comments": "the pedal's travel felt short"
+}
+JSON
+"$report" "$work" --generated "2026-01-01 00:00:00 UTC" > /dev/null
 flags=(--headless --no-sandbox --disable-gpu --no-first-run --user-data-dir="$work/profile" --disable-extensions
        --proxy-server=127.0.0.1:9 --proxy-bypass-list='<-loopback>' --hide-scrollbars --force-device-scale-factor=1
        --enable-logging=stderr --v=0 --virtual-time-budget=1000)
@@ -31,6 +43,9 @@ done
 grep -q '<td>membrane_released patch</td>' "$work/dom.html" || { echo "criteria table not filled"; fail=1; }
 grep -q '<td>tissue treatment</td>' "$work/dom.html" || { echo "score card not filled"; fail=1; }
 grep -q 'id="final-fundus" alt="final fundus" src="data:image/png;base64,' "$work/dom.html" || { echo "no final fundus"; fail=1; }
+grep -q 'rating 5 of 10: moderately objectionable difficulty' "$work/dom.html" || { echo "survey not shown"; fail=1; }
+grep -q '<td>very good — jaws &lt;b&gt;grip&lt;/b&gt; well</td>' "$work/dom.html" || { echo "survey comment not shown as text"; fail=1; }
+grep -q 'name="ins_forceps"' "$work/dom.html" || { echo "the survey form lacks the session's instruments"; fail=1; }
 [ "$fail" -eq 0 ] || exit 1
 
 mkdir -p "$shots"
