@@ -213,7 +213,7 @@ void write_array(JsonWriter& j, const std::vector<double>& v, const std::vector<
 
 }  // namespace
 
-std::string report_json(const SessionLog& log, const Survey* survey, const std::string& survey_problem) {
+std::string report_json(const SessionLog& log, const Survey* survey, const std::string& survey_problem, const std::string& trainee) {
   JsonWriter j;
   const ScoreRecord* score = final_or_last(log.scores);
   const CriteriaRecord* criteria = final_or_last(log.criteria);
@@ -244,6 +244,7 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
   j.key("messages_skipped").value(static_cast<std::int64_t>(log.messages_skipped));
   j.key("complete").value(log.complete);
   j.end_object();
+  j.key("trainee").value(trainee);
   j.key("notices").begin_array();
   for (const auto& n : notices) j.value(n);
   j.end_array();
@@ -259,6 +260,7 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
   j.field("elapsed_scored", totals ? totals->elapsed_s : 0.0, "s");
   j.field("session_length", last_t, "s");
   j.key("last_step").value(last_step);
+  j.key("started_utime_us").value(log.first_utime_us);  // the log's first event (wall clock, µs since the epoch)
   // The physics period, from the samples' own time and step (1 ms when the log has none).
   j.field("step_period", last_step > 0 ? last_t / static_cast<double>(last_step) : 0.001, "s");
   j.end_object();

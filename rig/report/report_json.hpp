@@ -14,6 +14,8 @@ inline constexpr int kReportFormat = 1;  // the layout of report.json (README)
 
 // survey: the session's post-session evaluation (DIR/survey.json), or null; survey_problem: why the
 // one in the folder was refused (a notice), empty when there was none or it was read.
-std::string report_json(const SessionLog& log, const Survey* survey = nullptr, const std::string& survey_problem = "");
+// trainee: who did the session (DIR/trainee.txt), "" when not named.
+std::string report_json(const SessionLog& log, const Survey* survey = nullptr, const std::string& survey_problem = "",
+                        const std::string& trainee = "");
 
 }  // namespace vitreo::report

@@ -135,7 +135,7 @@ SessionLog read_session_log(const std::string& path) {
     const auto st = reader.next(ev, static_cast<std::uint32_t>(telemetry::kDefaultMaxMessageBytes));
     if (st == telemetry::LcmLogReader::Status::End) break;
     if (st == telemetry::LcmLogReader::Status::Event) {
-      ++log.events_read;
+      if (log.events_read++ == 0) log.first_utime_us = ev.timestamp;
       if (!take(ev, log)) ++log.messages_skipped;
       continue;
     }

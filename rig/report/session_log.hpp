@@ -92,6 +92,7 @@ struct SessionLog {
   std::string path;
   std::uint64_t file_bytes = 0;
   std::uint64_t events_read = 0;      // LCM log events read
+  std::int64_t first_utime_us = 0;    // the first event's log timestamp: when the session started
   std::uint64_t messages_skipped = 0; // events that did not decode as their channel's type
   bool complete = true;               // the log ended exactly after an event
   std::string notice;                 // why it is not complete (empty when it is)

@@ -8,7 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rig/report/atomic_file.hpp"
 #include "rig/report/report_html.hpp"
+#include "rig/report/trainee_history.hpp"
 #include "rig/report/report_json.hpp"
 #include "rig/report/session_log.hpp"
 #include "rig/report/survey.hpp"
@@ -50,20 +52,6 @@ std::string read_file(const fs::path& p) {
   return ss.str();
 }
 
-void write_atomically(const fs::path& p, const std::string& text) {
-  const fs::path tmp = p.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
-  }
-  std::error_code ec;
-  fs::rename(tmp, p, ec);
-  if (ec) throw std::runtime_error("cannot rename " + tmp.string() + " to " + p.string() + ": " + ec.message());
-}
-
 }  // namespace
 
 WrittenReport write_report(const std::string& session_dir, const ReportOptions& options) {
@@ -83,7 +71,7 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
       survey_problem = e.what();
     }
   }
-  const std::string json = report_json(log, survey ? &*survey : nullptr, survey_problem);
+  const std::string json = report_json(log, survey ? &*survey : nullptr, survey_problem, read_trainee(session_dir));
 
   PageInputs page;
   page.report_json = json;

@@ -19,6 +19,7 @@ cmp "$work/a/report.json" "$work/c/report.json"
 diff <(sed 's/2026-01-01 00:00:00 UTC/TIME/' "$work/a/report.html") <(sed 's/2027-06-30 12:00:00 UTC/TIME/' "$work/c/report.html") > /dev/null
 cmp "$session/report.json" "$work/a/report.json"
 grep -q "report: exercise_pull_tissue" "$work/a.txt"
+grep -q '"trainee":"fellow-07"' "$session/report.json"   # vitreo --trainee, kept in DIR/trainee.txt
 
 # The embedded fundus is the last instructor frame.
 last=$(ls "$session"/frames/step_*_instructor.png | sort | tail -1)

@@ -9,7 +9,7 @@ rm -rf "$dir"
 mkdir -p "$dir"
 cd "$repo"
 "$vitreo" --case scenes/exercise_pull_tissue.toml --script scenes/scripts/exercise_pull_tissue.clumsy.toml \
-  --out "$dir" --unpaced --duration 8 --no-verify --eye-size 320 > "$dir/summary.txt" 2> "$dir/stderr.txt"
+  --out "$dir" --unpaced --duration 8 --no-verify --eye-size 320 --trainee fellow-07 > "$dir/summary.txt" 2> "$dir/stderr.txt"
 grep -q '^  report  ' "$dir/summary.txt" || { echo "the main job printed no report line"; cat "$dir/summary.txt"; exit 1; }
 test -s "$dir/report.json" && test -s "$dir/report.html"
 echo "session ready in $dir"
