@@ -443,6 +443,8 @@ int main(int argc, char** argv) {
         std::printf("  report           not written: %s\n", e.what());
       }
       std::fflush(stdout);
+    } else {
+      std::printf("  report           none: telemetry went to %s, not to a log (vitreo-report reads a log)\n", lcm_url.c_str());
     }
     if (verify_replay) {
       const auto r = vitreo::rig::replay_session(config.record_path, model);
