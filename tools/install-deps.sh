@@ -13,6 +13,10 @@ packages=(
   liblcm-dev liblcm-bin
   libusb-1.0-0-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev libpng-dev
+  # the session report (rig/report): Chart.js inlined into the page at build time, the survey
+  # form's JSON read with nlohmann-json; headless
+  # Chromium opens the page in its tests
+  libjs-chart.js chromium nlohmann-json3-dev
   # recordings: the running CRC-32 of their checksum blocks
   zlib1g-dev
   # tests and benchmarks

@@ -22,6 +22,10 @@ namespace vitreo::core {
 inline constexpr std::size_t kInstrumentEventKinds = static_cast<std::size_t>(InstrumentEventKind::kLaserBurn) + 1;
 
 // What the scores are computed from (SessionMetrics fills it, step by step).
+// The version of the formulas below and in compute_scores (README: Scores): raised whenever a
+// formula, weight or reference changes, so a debrief says which formulas its numbers came from.
+inline constexpr int kScoreFormulaVersion = 1;
+
 struct SessionTotals {
   double elapsed_s = 0.0;
   std::uint64_t steps = 0;

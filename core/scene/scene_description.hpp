@@ -87,7 +87,7 @@ enum class CriterionKind : std::uint8_t {
   kRetinaFlat,        // largest retina lift from the wall (mm) ≤ threshold
   kTimeLimit,         // elapsed s ≤ threshold
   kMembraneFreed,     // fraction of a membrane's area removed or in pieces no attachment holds ≥ threshold
-  kTargetsReached,    // fraction of a target guide's points reached in order by a working tip ≥ threshold
+  kTargetsReached,    // (keep last: rig/report walks the kinds up to it) fraction of a target guide's points reached in order by a working tip ≥ threshold
 };
 struct CriterionSpec {
   CriterionKind kind = CriterionKind::kGelRemoved;

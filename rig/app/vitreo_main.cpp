@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -24,6 +25,8 @@
 #include "rig/app/stop_signals.hpp"
 #include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/case_loader.hpp"
+#include "rig/report/trainee_history.hpp"
+#include "rig/report/write_report.hpp"
 #include "rig/session/rig_session.hpp"
 #include "rig/session/scripted_session.hpp"
 
@@ -165,6 +168,10 @@ int main(int argc, char** argv) {
                  "play this surgical script (scenes/scripts/*.toml) with the simulated devices (default: the first case's\n"
                  "expert script, scenes/scripts/CASE.expert.toml, when it has one)")
                          ->check(CLI::ExistingFile);
+  std::string trainee;
+  app.add_option("--trainee", trainee, "who does the session (1-64 characters of A-Z a-z 0-9 . _ -): kept in OUT/trainee.txt and "
+                 "named in the report, for `vitreo-report --trainee ID` (a learning curve)")
+      ->check([](const std::string& id) { return vitreo::report::valid_trainee_id(id) ? std::string() : "1-64 characters of A-Z a-z 0-9 . _ -"; });
   app.add_flag("--idle", idle, "play no script: the simulated hand stays outside the eye, the pedals at rest")->excludes(script_opt);
   auto* lockstep_opt = app.add_flag("--lockstep", lockstep,
                "simulated devices on the simulation's clock: each step waits for its inputs, so a scripted session\n"
@@ -243,6 +250,13 @@ int main(int argc, char** argv) {
         case vitreo::telemetry::RecordingVerdict::Complete: return r.matches_recording() ? 0 : 3;
       }
       return 1;
+    }
+
+    // Who does this session (a replay above leaves the folder's as it was).
+    if (!trainee.empty()) {
+      std::ofstream(out / "trainee.txt") << trainee << '\n';
+    } else {
+      fs::remove(out / "trainee.txt");  // a folder reused for another session names no one from before
     }
 
     // The case list: --case files in order, or a folder's cases (scenes/ by default).
@@ -419,6 +433,19 @@ int main(int argc, char** argv) {
     std::printf("  state hash       %016llx\n", static_cast<unsigned long long>(s.state_hash));
     std::fflush(stdout);
     sync_file(config.lcm_url);  // the telemetry log, when it is one (the recording synced itself)
+    // The debrief, from the telemetry log just written (rig/report): it never fails the session.
+    if (lcm_url.empty()) {
+      try {
+        const auto r = vitreo::report::write_report(out.string());
+        std::printf("  report           %s (numbers: %s)%s\n", r.html_path.c_str(), r.json_path.c_str(),
+                    r.notices.empty() ? "" : (" — " + r.notices.front()).c_str());
+      } catch (const std::exception& e) {
+        std::printf("  report           not written: %s\n", e.what());
+      }
+      std::fflush(stdout);
+    } else {
+      std::printf("  report           none: telemetry went to %s, not to a log (vitreo-report reads a log)\n", lcm_url.c_str());
+    }
     if (verify_replay) {
       const auto r = vitreo::rig::replay_session(config.record_path, model);
       const bool complete = r.verdict == vitreo::telemetry::RecordingVerdict::Complete;

@@ -23,6 +23,7 @@
 #include "rig/telemetry/recording.hpp"
 #include "rig/telemetry/terminal_commands.hpp"
 #include "rig/session/case_switcher.hpp"
+#include "rig/session/event_keys.hpp"
 #include "rig/session/frame_source.hpp"
 #include "rig/session/snapshot_writer.hpp"
 #include "vitreo/render/render_thread.hpp"
@@ -43,6 +44,10 @@ telemetry::Event to_event(const core::TissueEvent& e, std::int64_t step, double 
   ev.tissue_id = static_cast<std::int32_t>(e.surface);
   for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
   ev.magnitude = e.magnitude;
+  // Prefixed: the instruments pass a broken attachment on as their own event too (event_keys.hpp).
+  telemetry::copy_text(ev.what, e.kind == core::TissueEventKind::kTear           ? "tissue_tear"
+                                : e.kind == core::TissueEventKind::kGripBroken ? "tissue_grip_broken"
+                                                                                : "tissue_attachment_broken");
   return ev;
 }
 
@@ -89,6 +94,7 @@ telemetry::Event instrument_event(const core::InstrumentEvent& e, std::int64_t s
   if (on_tissue && e.other != core::kNone) ev.tissue_id = static_cast<std::int32_t>(e.other);
   for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
   ev.magnitude = e.magnitude;
+  telemetry::copy_text(ev.what, event_key(e.kind));
   return ev;
 }
 
@@ -143,6 +149,63 @@ telemetry::Score score_item(SimulationModel& model, std::int64_t step, bool fina
     s.value[s.n++] = e.value;
   }
   return s;
+}
+
+// The criteria the last score() measured, and the totals behind the score card (the debrief's inputs).
+telemetry::Criteria criteria_item(SimulationModel& model, std::int64_t step, bool final_score) {
+  telemetry::Criteria c;
+  c.step = step;
+  telemetry::copy_text(c.case_id, model.scene().description.name);
+  c.final_score = final_score;
+  for (const core::CriterionProgress& p : model.metrics().criteria()) {
+    if (c.n == telemetry::Criteria::kMax) break;
+    telemetry::copy_text(c.kind[c.n], core::to_string(p.kind));
+    telemetry::copy_text(c.target[c.n], p.target);
+    c.value[c.n] = p.value;
+    c.threshold[c.n] = p.threshold;
+    c.progress[c.n] = p.progress;
+    c.met[c.n++] = p.met;
+  }
+  return c;
+}
+
+telemetry::Totals totals_item(SimulationModel& model, std::int64_t step, bool final_score) {
+  const core::SessionMetrics& m = model.metrics();
+  const core::SessionTotals& t = m.totals();
+  telemetry::Totals o;
+  o.step = step;
+  telemetry::copy_text(o.case_id, model.scene().description.name);
+  o.final_score = final_score;
+  o.formula_version = core::kScoreFormulaVersion;
+  o.elapsed_s = t.elapsed_s;
+  o.path_length_mm = t.path_length_mm;
+  o.retina_contacts = static_cast<std::int32_t>(t.retina_contacts);
+  o.retina_contact_time_s = t.retina_contact_time_s;
+  o.peak_retina_force_un = t.peak_retina_force_un;
+  o.retina_force_impulse_un_s = t.retina_force_impulse_un_s;
+  o.time_over_force_limit_s = t.time_over_force_limit_s;
+  o.force_limit_un = t.force_limit_un;
+  o.burns_on_target = static_cast<std::int32_t>(t.burns_on_target);
+  o.burns_elsewhere = static_cast<std::int32_t>(t.burns_elsewhere);
+  o.retina_tears = static_cast<std::int32_t>(t.retina_tears);
+  o.other_tears = static_cast<std::int32_t>(t.other_tears);
+  o.iatrogenic_events = static_cast<std::int32_t>(t.iatrogenic_events());
+  o.illumination_measured = t.illumination_measured;
+  o.working_time_s = t.working_time_s;
+  o.lit_working_time_s = t.lit_working_time_s;
+  for (std::size_t k = 0; k < core::kInstrumentEventKinds && o.n_kinds < telemetry::Totals::kMaxKinds; ++k) {
+    telemetry::copy_text(o.event_kind[o.n_kinds], event_key(static_cast<core::InstrumentEventKind>(k)));
+    o.event_count[o.n_kinds++] = static_cast<std::int32_t>(t.events[k]);
+  }
+  for (std::uint32_t i = 0; i < m.instrument_count() && o.n_instruments < telemetry::Totals::kMaxInstruments; ++i) {
+    const core::InstrumentMetrics& im = m.instrument(i);
+    telemetry::copy_text(o.instrument_kind[o.n_instruments], core::to_string(im.kind));
+    o.instrument_path_mm[o.n_instruments] = im.path_length_mm;
+    o.instrument_contacts[o.n_instruments] = static_cast<std::int32_t>(im.retina_contacts);
+    o.instrument_peak_force_un[o.n_instruments] = im.peak_retina_force_un;
+    o.instrument_contact_time_s[o.n_instruments++] = im.retina_contact_time_s;
+  }
+  return o;
 }
 
 // The final score and the case's criteria, for the summaries (live and replay print the same lines).
@@ -328,11 +391,16 @@ SessionSummary run_session(const SessionConfig& config) {
       case_over_complete.store(model.metrics().completed(), std::memory_order_relaxed);
       case_over_step.store(step, std::memory_order_release);
       physics_out.push(score_item(model, step, true));
+      physics_out.push(criteria_item(model, step, true));
+      physics_out.push(totals_item(model, step, true));
     }
     // The model's metrics observed the step; running scores go out at a low rate (score() scans
     // the world), the final one with the last step.
-    if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0))
+    if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0)) {
       physics_out.push(score_item(model, step, last));
+      physics_out.push(criteria_item(model, step, last));  // what score() just measured
+      physics_out.push(totals_item(model, step, last));
+    }
     for (const auto& slot : model.instruments()) {
       if (slot.frozen) {
         ++summary.frozen_steps;
@@ -354,8 +422,27 @@ SessionSummary run_session(const SessionConfig& config) {
     if (k % 4 == 0) {  // instrument state at 250 Hz (CHANNELS.md)
       const auto& slots = model.instruments();
       for (std::size_t i = 0; i < slots.size(); ++i) {
-        if (slots[i].present) physics_out.push(to_state(slots[i], held_instrument(model, i), static_cast<int>(i), step, t_s));
+        if (!slots[i].present) continue;
+        telemetry::InstrumentState st = to_state(slots[i], held_instrument(model, i), static_cast<int>(i), step, t_s);
+        // The simulated instrument this tracker drives now: the tool in the hand or the light pipe.
+        const int sim = i == static_cast<std::size_t>(kToolTracker)         ? model.selected_tool()
+                        : i == static_cast<std::size_t>(kLightPipeTracker) ? model.current_case().light_pipe
+                                                                            : -1;
+        if (sim >= 0 && static_cast<std::uint32_t>(sim) < model.simulation().instrument_count())
+          st.retina_force_un = model.simulation().instrument(static_cast<std::uint32_t>(sim)).retina_force_un;
+        physics_out.push(st);
       }
+      const SurgicalControls& c = model.controls();
+      telemetry::Controls ctl;
+      ctl.step = step;
+      ctl.t_s = t_s;
+      ctl.vacuum_mmhg = c.vacuum_mmhg;
+      ctl.cut_rate_cpm = c.cut_rate_cpm;
+      ctl.reflux = c.reflux;
+      ctl.laser_fire = c.laser_fire;
+      ctl.light_level = c.light_level;
+      ctl.zoom = c.zoom;
+      physics_out.push(ctl);
     }
     if (renderer && (k % view_every == 0 || last)) {
       if (capture_view(model, k, t_s, views.write_slot())) views.publish();

@@ -39,6 +39,7 @@ struct InstrumentState {
   double insertion_mm = 0;
   double actuation = 0;
   bool frozen = false;
+  double retina_force_un = 0;
 };
 
 enum class EventKind : std::int8_t { Contact = 1, Cut = 2, Tear = 3, Burn = 4, Drain = 5, AttachmentBroken = 6 };
@@ -51,6 +52,7 @@ struct Event {
   std::int32_t tissue_id = -1;
   double position_mm[3] = {};
   double magnitude = 0;  // unit per kind: see event_t.lcm
+  char what[24] = {};    // the simulation's name of the event
 };
 
 struct PhysicsTiming {
@@ -88,7 +90,55 @@ struct Score {
   double value[kMaxMetrics] = {};
 };
 
-using TelemetryItem = std::variant<InstrumentState, Event, PhysicsTiming, DeviceStatus, Score>;
+// The case's criteria with a score card (criteria_t).
+struct Criteria {
+  static constexpr std::size_t kMax = 8;
+  std::int64_t step = 0;
+  char case_id[32] = {};
+  bool final_score = false;
+  std::uint8_t n = 0;
+  char kind[kMax][20] = {};
+  char target[kMax][24] = {};
+  double value[kMax] = {}, threshold[kMax] = {}, progress[kMax] = {};
+  bool met[kMax] = {};
+};
+
+// The scoring's accumulated inputs with a score card (session_totals_t).
+struct Totals {
+  static constexpr std::size_t kMaxKinds = 16;
+  static constexpr std::size_t kMaxInstruments = 6;
+  std::int64_t step = 0;
+  char case_id[32] = {};
+  bool final_score = false;
+  std::int32_t formula_version = 0;
+  double elapsed_s = 0, path_length_mm = 0;
+  std::int32_t retina_contacts = 0;
+  double retina_contact_time_s = 0, peak_retina_force_un = 0, retina_force_impulse_un_s = 0;
+  double time_over_force_limit_s = 0, force_limit_un = 0;
+  std::int32_t burns_on_target = 0, burns_elsewhere = 0, retina_tears = 0, other_tears = 0, iatrogenic_events = 0;
+  bool illumination_measured = false;
+  double working_time_s = 0, lit_working_time_s = 0;
+  std::uint8_t n_kinds = 0;
+  char event_kind[kMaxKinds][24] = {};
+  std::int32_t event_count[kMaxKinds] = {};
+  std::uint8_t n_instruments = 0;
+  char instrument_kind[kMaxInstruments][16] = {};
+  double instrument_path_mm[kMaxInstruments] = {};
+  std::int32_t instrument_contacts[kMaxInstruments] = {};
+  double instrument_peak_force_un[kMaxInstruments] = {};
+  double instrument_contact_time_s[kMaxInstruments] = {};
+};
+
+// The pedals' surgical controls (controls_t).
+struct Controls {
+  std::int64_t step = 0;
+  double t_s = 0;
+  double vacuum_mmhg = 0, cut_rate_cpm = 0;
+  bool reflux = false, laser_fire = false;
+  double light_level = 0, zoom = 1;
+};
+
+using TelemetryItem = std::variant<InstrumentState, Event, PhysicsTiming, DeviceStatus, Score, Criteria, Totals, Controls>;
 static_assert(std::is_trivially_copyable_v<TelemetryItem>, "ring items must be memcpy-able");
 
 }  // namespace vitreo::telemetry

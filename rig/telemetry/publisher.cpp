@@ -5,12 +5,15 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "vitreo_lcm/controls_t.hpp"
+#include "vitreo_lcm/criteria_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/event_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 #include "vitreo_lcm/physics_timing_t.hpp"
 #include "vitreo_lcm/receive_status_t.hpp"
 #include "vitreo_lcm/score_t.hpp"
+#include "vitreo_lcm/session_totals_t.hpp"
 
 namespace vitreo::telemetry {
 
@@ -120,6 +123,7 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.insertion_mm = v.insertion_mm;
           m.actuation = v.actuation;
           m.frozen = v.frozen;
+          m.retina_force_un = v.retina_force_un;
           rc = publish(lcm_, kChanInstrumentState, m);
         } else if constexpr (std::is_same_v<T, Event>) {
           vitreo_lcm::event_t m;
@@ -131,6 +135,7 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.tissue_id = v.tissue_id;
           for (int i = 0; i < 3; ++i) m.position_mm[i] = v.position_mm[i];
           m.magnitude = v.magnitude;
+          m.what = text(v.what);
           rc = publish(lcm_, kChanEvent, m);
         } else if constexpr (std::is_same_v<T, PhysicsTiming>) {
           vitreo_lcm::physics_timing_t m;
@@ -192,6 +197,74 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
             m.value.push_back(v.value[i]);
           }
           rc = publish(lcm_, kChanScore, m);
+        } else if constexpr (std::is_same_v<T, Criteria>) {
+          vitreo_lcm::criteria_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.case_id = text(v.case_id);
+          m.final_score = v.final_score;
+          const std::size_t n = std::min<std::size_t>(v.n, Criteria::kMax);
+          m.n = static_cast<std::int16_t>(n);
+          for (std::size_t i = 0; i < n; ++i) {
+            m.kind.emplace_back(text(v.kind[i]));
+            m.target.emplace_back(text(v.target[i]));
+            m.value.push_back(v.value[i]);
+            m.threshold.push_back(v.threshold[i]);
+            m.progress.push_back(v.progress[i]);
+            m.met.push_back(v.met[i]);
+          }
+          rc = publish(lcm_, kChanCriteria, m);
+        } else if constexpr (std::is_same_v<T, Totals>) {
+          vitreo_lcm::session_totals_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.case_id = text(v.case_id);
+          m.final_score = v.final_score;
+          m.formula_version = v.formula_version;
+          m.elapsed_s = v.elapsed_s;
+          m.path_length_mm = v.path_length_mm;
+          m.retina_contacts = v.retina_contacts;
+          m.retina_contact_time_s = v.retina_contact_time_s;
+          m.peak_retina_force_un = v.peak_retina_force_un;
+          m.retina_force_impulse_un_s = v.retina_force_impulse_un_s;
+          m.time_over_force_limit_s = v.time_over_force_limit_s;
+          m.force_limit_un = v.force_limit_un;
+          m.burns_on_target = v.burns_on_target;
+          m.burns_elsewhere = v.burns_elsewhere;
+          m.retina_tears = v.retina_tears;
+          m.other_tears = v.other_tears;
+          m.iatrogenic_events = v.iatrogenic_events;
+          m.illumination_measured = v.illumination_measured;
+          m.working_time_s = v.working_time_s;
+          m.lit_working_time_s = v.lit_working_time_s;
+          const std::size_t nk = std::min<std::size_t>(v.n_kinds, Totals::kMaxKinds);
+          m.n_kinds = static_cast<std::int16_t>(nk);
+          for (std::size_t i = 0; i < nk; ++i) {
+            m.event_kind.emplace_back(text(v.event_kind[i]));
+            m.event_count.push_back(v.event_count[i]);
+          }
+          const std::size_t ni = std::min<std::size_t>(v.n_instruments, Totals::kMaxInstruments);
+          m.n_instruments = static_cast<std::int8_t>(ni);
+          for (std::size_t i = 0; i < ni; ++i) {
+            m.instrument_kind.emplace_back(text(v.instrument_kind[i]));
+            m.instrument_path_mm.push_back(v.instrument_path_mm[i]);
+            m.instrument_contacts.push_back(v.instrument_contacts[i]);
+            m.instrument_peak_force_un.push_back(v.instrument_peak_force_un[i]);
+            m.instrument_contact_time_s.push_back(v.instrument_contact_time_s[i]);
+          }
+          rc = publish(lcm_, kChanTotals, m);
+        } else if constexpr (std::is_same_v<T, Controls>) {
+          vitreo_lcm::controls_t m;
+          m.utime_us = now;
+          m.step = v.step;
+          m.t_s = v.t_s;
+          m.vacuum_mmhg = v.vacuum_mmhg;
+          m.cut_rate_cpm = v.cut_rate_cpm;
+          m.reflux = v.reflux;
+          m.laser_fire = v.laser_fire;
+          m.light_level = v.light_level;
+          m.zoom = v.zoom;
+          rc = publish(lcm_, kChanControls, m);
         }
       },
       item);

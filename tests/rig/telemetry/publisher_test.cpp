@@ -20,11 +20,14 @@
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
+#include "vitreo_lcm/controls_t.hpp"
+#include "vitreo_lcm/criteria_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/event_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 #include "vitreo_lcm/physics_timing_t.hpp"
 #include "vitreo_lcm/score_t.hpp"
+#include "vitreo_lcm/session_totals_t.hpp"
 
 using namespace vitreo::telemetry;
 
@@ -126,6 +129,151 @@ TEST(TelemetryPublisher, MemqRoundTripOfEveryItemType) {
   EXPECT_DOUBLE_EQ(scores.got[0].value[1], 65.5);
   EXPECT_EQ(pub.published(), 5u);
   EXPECT_EQ(pub.dropped(), 0u);
+}
+
+// What the session report reads (rig/report): criteria, the scoring's totals, the pedals' controls,
+// each instrument's retina force and the events' own names — every field as it was pushed.
+TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
+  TelemetryPublisher pub(PublisherConfig{"memq://", 64});
+  TelemetrySource& physics = pub.add_source("physics");
+  Collector<vitreo_lcm::instrument_state_t> states;
+  Collector<vitreo_lcm::event_t> events;
+  Collector<vitreo_lcm::criteria_t> criteria;
+  Collector<vitreo_lcm::session_totals_t> totals;
+  Collector<vitreo_lcm::controls_t> controls;
+  auto sub1 = subscribe_to<decltype(states.got)::value_type>(pub.lcm(), kChanInstrumentState, &states);
+  auto sub2 = subscribe_to<decltype(events.got)::value_type>(pub.lcm(), kChanEvent, &events);
+  auto sub3 = subscribe_to<decltype(criteria.got)::value_type>(pub.lcm(), kChanCriteria, &criteria);
+  auto sub4 = subscribe_to<decltype(totals.got)::value_type>(pub.lcm(), kChanTotals, &totals);
+  auto sub5 = subscribe_to<decltype(controls.got)::value_type>(pub.lcm(), kChanControls, &controls);
+
+  InstrumentState st = make_state(8);
+  st.retina_force_un = 2750.5;
+  ASSERT_TRUE(physics.push(st));
+  Event e;
+  e.kind = EventKind::Contact;
+  copy_text(e.what, "excessive_retina_force");
+  ASSERT_TRUE(physics.push(e));
+  Criteria c;
+  c.step = 999;
+  copy_text(c.case_id, "exercise_pull_tissue");
+  c.final_score = true;
+  c.n = 2;
+  copy_text(c.kind[0], "membrane_released");
+  copy_text(c.target[0], "patch");
+  c.value[0] = 0.4;
+  c.threshold[0] = 1.0;
+  c.progress[0] = 0.4;
+  copy_text(c.kind[1], "time_limit");
+  c.value[1] = 12.5;
+  c.threshold[1] = 120;
+  c.progress[1] = 0.9;
+  c.met[1] = true;
+  ASSERT_TRUE(physics.push(c));
+  Totals t;
+  t.step = 999;
+  copy_text(t.case_id, "exercise_pull_tissue");
+  t.formula_version = 1;
+  t.elapsed_s = 8;
+  t.path_length_mm = 33.75;
+  t.retina_contacts = 4;
+  t.retina_contact_time_s = 0.15;
+  t.peak_retina_force_un = 22336;
+  t.retina_force_impulse_un_s = 986;
+  t.time_over_force_limit_s = 0.13;
+  t.force_limit_un = 3000;
+  t.burns_on_target = 5;
+  t.burns_elsewhere = 1;
+  t.retina_tears = 2;
+  t.other_tears = 3;
+  t.iatrogenic_events = 15;
+  t.illumination_measured = true;
+  t.working_time_s = 6;
+  t.lit_working_time_s = 4.5;
+  t.n_kinds = 2;
+  copy_text(t.event_kind[0], "wall_contact");
+  t.event_count[0] = 9;
+  copy_text(t.event_kind[1], "excessive_retina_force");
+  t.event_count[1] = 6;
+  t.n_instruments = 1;
+  copy_text(t.instrument_kind[0], "forceps");
+  t.instrument_path_mm[0] = 33.75;
+  t.instrument_contacts[0] = 4;
+  t.instrument_peak_force_un[0] = 22336;
+  t.instrument_contact_time_s[0] = 0.15;
+  ASSERT_TRUE(physics.push(t));
+  Controls k;
+  k.step = 12;
+  k.t_s = 0.012;
+  k.vacuum_mmhg = 350;
+  k.cut_rate_cpm = 5000;
+  k.reflux = true;
+  k.laser_fire = true;
+  k.light_level = 0.7;
+  k.zoom = 1.5;
+  ASSERT_TRUE(physics.push(k));
+
+  EXPECT_EQ(pub.pump(), 5u);
+  while (pub.handle_incoming() > 0) {
+  }
+  ASSERT_EQ(states.got.size(), 1u);
+  EXPECT_DOUBLE_EQ(states.got[0].retina_force_un, 2750.5);
+  ASSERT_EQ(events.got.size(), 1u);
+  EXPECT_EQ(events.got[0].what, "excessive_retina_force");
+  ASSERT_EQ(criteria.got.size(), 1u);
+  const auto& cg = criteria.got[0];
+  EXPECT_EQ(cg.step, 999);
+  EXPECT_EQ(cg.case_id, "exercise_pull_tissue");
+  EXPECT_TRUE(cg.final_score);
+  ASSERT_EQ(cg.n, 2);
+  EXPECT_EQ(cg.kind[0], "membrane_released");
+  EXPECT_EQ(cg.target[0], "patch");
+  EXPECT_EQ(cg.target[1], "");
+  EXPECT_DOUBLE_EQ(cg.value[0], 0.4);
+  EXPECT_DOUBLE_EQ(cg.threshold[1], 120);
+  EXPECT_DOUBLE_EQ(cg.progress[1], 0.9);
+  EXPECT_FALSE(cg.met[0]);
+  EXPECT_TRUE(cg.met[1]);
+  ASSERT_EQ(totals.got.size(), 1u);
+  const auto& tg = totals.got[0];
+  EXPECT_EQ(tg.formula_version, 1);
+  EXPECT_FALSE(tg.final_score);
+  EXPECT_DOUBLE_EQ(tg.elapsed_s, 8);
+  EXPECT_DOUBLE_EQ(tg.path_length_mm, 33.75);
+  EXPECT_EQ(tg.retina_contacts, 4);
+  EXPECT_DOUBLE_EQ(tg.retina_contact_time_s, 0.15);
+  EXPECT_DOUBLE_EQ(tg.peak_retina_force_un, 22336);
+  EXPECT_DOUBLE_EQ(tg.retina_force_impulse_un_s, 986);
+  EXPECT_DOUBLE_EQ(tg.time_over_force_limit_s, 0.13);
+  EXPECT_DOUBLE_EQ(tg.force_limit_un, 3000);
+  EXPECT_EQ(tg.burns_on_target, 5);
+  EXPECT_EQ(tg.burns_elsewhere, 1);
+  EXPECT_EQ(tg.retina_tears, 2);
+  EXPECT_EQ(tg.other_tears, 3);
+  EXPECT_EQ(tg.iatrogenic_events, 15);
+  EXPECT_TRUE(tg.illumination_measured);
+  EXPECT_DOUBLE_EQ(tg.working_time_s, 6);
+  EXPECT_DOUBLE_EQ(tg.lit_working_time_s, 4.5);
+  ASSERT_EQ(tg.n_kinds, 2);
+  EXPECT_EQ(tg.event_kind[1], "excessive_retina_force");
+  EXPECT_EQ(tg.event_count[0], 9);
+  ASSERT_EQ(tg.n_instruments, 1);
+  EXPECT_EQ(tg.instrument_kind[0], "forceps");
+  EXPECT_DOUBLE_EQ(tg.instrument_path_mm[0], 33.75);
+  EXPECT_EQ(tg.instrument_contacts[0], 4);
+  EXPECT_DOUBLE_EQ(tg.instrument_peak_force_un[0], 22336);
+  EXPECT_DOUBLE_EQ(tg.instrument_contact_time_s[0], 0.15);
+  ASSERT_EQ(controls.got.size(), 1u);
+  const auto& kg = controls.got[0];
+  EXPECT_EQ(kg.step, 12);
+  EXPECT_DOUBLE_EQ(kg.t_s, 0.012);
+  EXPECT_DOUBLE_EQ(kg.vacuum_mmhg, 350);
+  EXPECT_DOUBLE_EQ(kg.cut_rate_cpm, 5000);
+  EXPECT_TRUE(kg.reflux);
+  EXPECT_TRUE(kg.laser_fire);
+  EXPECT_DOUBLE_EQ(kg.light_level, 0.7);
+  EXPECT_DOUBLE_EQ(kg.zoom, 1.5);
+  EXPECT_GT(kg.utime_us, 0);
 }
 
 TEST(TelemetryPublisher, FullRingDropsAndCountsInsteadOfWaiting) {

@@ -1,0 +1,155 @@
+#include "rig/report/session_log.hpp"
+
+#include <stdexcept>
+
+#include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/lcm_decode.hpp"
+#include "rig/telemetry/lcm_log_reader.hpp"
+#include "rig/telemetry/lcm_subscribe.hpp"
+#include "vitreo_lcm/controls_t.hpp"
+#include "vitreo_lcm/criteria_t.hpp"
+#include "vitreo_lcm/event_t.hpp"
+#include "vitreo_lcm/instrument_state_t.hpp"
+#include "vitreo_lcm/score_t.hpp"
+#include "vitreo_lcm/session_totals_t.hpp"
+
+namespace vitreo::report {
+
+namespace {
+
+using telemetry::DecodeError;
+using telemetry::decode_message;
+
+template <class Msg>
+bool decode(const telemetry::LcmLogEvent& ev, Msg& m) {
+  return decode_message(ev.data.data(), ev.data.size(), m, telemetry::kDefaultMaxMessageBytes) == DecodeError::None;
+}
+
+// Records one decoded event; false when its bytes did not decode as its channel's type.
+bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
+  namespace t = telemetry;
+  if (ev.channel == t::kChanInstrumentState) {
+    vitreo_lcm::instrument_state_t m{};
+    if (!decode(ev, m)) return false;
+    TipSample s;
+    s.step = m.step;
+    s.t_s = m.t_s;
+    s.instrument = m.instrument_id;
+    s.port = m.port_id;
+    s.kind = m.kind;
+    for (int i = 0; i < 3; ++i) s.tip_mm[static_cast<std::size_t>(i)] = m.tip_mm[i];
+    s.insertion_mm = m.insertion_mm;
+    s.actuation = m.actuation;
+    s.retina_force_un = m.retina_force_un;
+    s.frozen = m.frozen;
+    log.tips.push_back(std::move(s));
+  } else if (ev.channel == t::kChanEvent) {
+    vitreo_lcm::event_t m{};
+    if (!decode(ev, m)) return false;
+    EventRecord e;
+    e.step = m.step;
+    e.t_s = m.t_s;
+    e.kind = m.kind;
+    e.instrument = m.instrument_id;
+    e.tissue = m.tissue_id;
+    for (int i = 0; i < 3; ++i) e.position_mm[static_cast<std::size_t>(i)] = m.position_mm[i];
+    e.magnitude = m.magnitude;
+    e.what = m.what;
+    log.events.push_back(std::move(e));
+  } else if (ev.channel == t::kChanScore) {
+    vitreo_lcm::score_t m{};
+    if (!decode(ev, m)) return false;
+    ScoreRecord s;
+    s.step = m.step;
+    s.case_id = m.case_id;
+    s.final_score = m.final_score;
+    s.total = m.total;
+    for (std::size_t i = 0; i < m.name.size() && i < m.value.size(); ++i) s.categories.emplace_back(m.name[i], m.value[i]);
+    log.scores.push_back(std::move(s));
+  } else if (ev.channel == t::kChanCriteria) {
+    vitreo_lcm::criteria_t m{};
+    if (!decode(ev, m)) return false;
+    CriteriaRecord c;
+    c.step = m.step;
+    c.case_id = m.case_id;
+    c.final_score = m.final_score;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(m.n); ++i)
+      c.criteria.push_back({m.kind[i], m.target[i], m.value[i], m.threshold[i], m.progress[i], m.met[i] != 0});
+    log.criteria.push_back(std::move(c));
+  } else if (ev.channel == t::kChanTotals) {
+    vitreo_lcm::session_totals_t m{};
+    if (!decode(ev, m)) return false;
+    TotalsRecord r;
+    r.step = m.step;
+    r.case_id = m.case_id;
+    r.final_score = m.final_score;
+    r.formula_version = m.formula_version;
+    r.elapsed_s = m.elapsed_s;
+    r.path_length_mm = m.path_length_mm;
+    r.retina_contacts = m.retina_contacts;
+    r.retina_contact_time_s = m.retina_contact_time_s;
+    r.peak_retina_force_un = m.peak_retina_force_un;
+    r.retina_force_impulse_un_s = m.retina_force_impulse_un_s;
+    r.time_over_force_limit_s = m.time_over_force_limit_s;
+    r.force_limit_un = m.force_limit_un;
+    r.burns_on_target = m.burns_on_target;
+    r.burns_elsewhere = m.burns_elsewhere;
+    r.retina_tears = m.retina_tears;
+    r.other_tears = m.other_tears;
+    r.iatrogenic_events = m.iatrogenic_events;
+    r.illumination_measured = m.illumination_measured;
+    r.working_time_s = m.working_time_s;
+    r.lit_working_time_s = m.lit_working_time_s;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(m.n_kinds); ++i) r.events_by_kind.emplace_back(m.event_kind[i], m.event_count[i]);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(m.n_instruments); ++i)
+      r.instruments.push_back({m.instrument_kind[i], m.instrument_path_mm[i], m.instrument_peak_force_un[i],
+                               m.instrument_contact_time_s[i], m.instrument_contacts[i]});
+    log.totals.push_back(std::move(r));
+  } else if (ev.channel == t::kChanControls) {
+    vitreo_lcm::controls_t m{};
+    if (!decode(ev, m)) return false;
+    ControlsRecord c;
+    c.step = m.step;
+    c.t_s = m.t_s;
+    c.vacuum_mmhg = m.vacuum_mmhg;
+    c.cut_rate_cpm = m.cut_rate_cpm;
+    c.light_level = m.light_level;
+    c.zoom = m.zoom;
+    c.reflux = m.reflux;
+    c.laser_fire = m.laser_fire;
+    log.controls.push_back(c);
+  }
+  return true;  // other channels (device status, timing, acks) are not part of the debrief
+}
+
+}  // namespace
+
+SessionLog read_session_log(const std::string& path) {
+  SessionLog log;
+  log.path = path;
+  telemetry::LcmLogReader reader;
+  if (!reader.open(path)) throw std::runtime_error(reader.problem());
+  log.file_bytes = reader.file_size();
+  telemetry::LcmLogEvent ev;
+  for (;;) {
+    const auto st = reader.next(ev, static_cast<std::uint32_t>(telemetry::kDefaultMaxMessageBytes));
+    if (st == telemetry::LcmLogReader::Status::End) break;
+    if (st == telemetry::LcmLogReader::Status::Event) {
+      if (log.events_read++ == 0) log.first_utime_us = ev.timestamp;
+      if (!take(ev, log)) ++log.messages_skipped;
+      continue;
+    }
+    log.complete = false;
+    const std::string where = "byte " + std::to_string(reader.offset()) + " of " + std::to_string(log.file_bytes);
+    log.notice = st == telemetry::LcmLogReader::Status::Truncated
+                     ? "the telemetry log ends inside an event at " + where + " (truncated: the session was cut off or the file is incomplete)"
+                     : "the telemetry log is corrupted at " + where + " (" + reader.problem() + ")";
+    log.notice += "; the report shows the " + std::to_string(log.events_read) + " events before it";
+    break;
+  }
+  if (log.events_read == 0)
+    throw std::runtime_error("'" + path + "' holds no readable LCM event" + (log.notice.empty() ? "" : ": " + log.notice));
+  return log;
+}
+
+}  // namespace vitreo::report

@@ -1,0 +1,110 @@
+#pragma once
+// A session's telemetry log (the LCM log the main job writes to OUT/telemetry.lcmlog), read into
+// plain records for the debrief. Only what the report uses is kept; everything is taken from the
+// messages as the rig published them (no recomputation of scores or criteria here).
+//
+// A log that stops inside an event or holds bytes that are not an event is read up to there: the
+// records before it are kept and `notice` says where and why it stopped. A message that does not
+// decode is skipped and counted. Only a file that cannot be opened, or that holds no readable event
+// at all, is an error (read_session_log throws std::runtime_error with the reason).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vitreo::report {
+
+struct TipSample {
+  std::int64_t step = 0;
+  double t_s = 0;
+  int instrument = 0;  // tracker slot (instrument_state_t.instrument_id)
+  int port = -1;       // -1: outside the eye
+  std::string kind;
+  std::array<double, 3> tip_mm{};
+  double insertion_mm = 0;
+  double actuation = 0;
+  double retina_force_un = 0;
+  bool frozen = false;
+};
+
+struct EventRecord {
+  std::int64_t step = 0;
+  double t_s = 0;
+  int kind = 0;  // event_t::KIND_*
+  int instrument = -1;
+  int tissue = -1;
+  std::array<double, 3> position_mm{};
+  double magnitude = 0;
+  std::string what;
+};
+
+struct ScoreRecord {
+  std::int64_t step = 0;
+  std::string case_id;
+  bool final_score = false;
+  double total = 0;
+  std::vector<std::pair<std::string, double>> categories;
+};
+
+struct CriterionRecord {
+  std::string kind, target;
+  double value = 0, threshold = 0, progress = 0;
+  bool met = false;
+};
+
+struct CriteriaRecord {
+  std::int64_t step = 0;
+  std::string case_id;
+  bool final_score = false;
+  std::vector<CriterionRecord> criteria;
+};
+
+struct InstrumentTotals {
+  std::string kind;
+  double path_mm = 0, peak_force_un = 0, contact_time_s = 0;
+  std::int32_t contacts = 0;
+};
+
+struct TotalsRecord {
+  std::int64_t step = 0;
+  std::string case_id;
+  bool final_score = false;
+  std::int32_t formula_version = 0;
+  double elapsed_s = 0, path_length_mm = 0;
+  std::int32_t retina_contacts = 0;
+  double retina_contact_time_s = 0, peak_retina_force_un = 0, retina_force_impulse_un_s = 0;
+  double time_over_force_limit_s = 0, force_limit_un = 0;
+  std::int32_t burns_on_target = 0, burns_elsewhere = 0, retina_tears = 0, other_tears = 0, iatrogenic_events = 0;
+  bool illumination_measured = false;
+  double working_time_s = 0, lit_working_time_s = 0;
+  std::vector<std::pair<std::string, std::int32_t>> events_by_kind;
+  std::vector<InstrumentTotals> instruments;
+};
+
+struct ControlsRecord {
+  std::int64_t step = 0;
+  double t_s = 0;
+  double vacuum_mmhg = 0, cut_rate_cpm = 0, light_level = 0, zoom = 1;
+  bool reflux = false, laser_fire = false;
+};
+
+struct SessionLog {
+  std::string path;
+  std::uint64_t file_bytes = 0;
+  std::uint64_t events_read = 0;      // LCM log events read
+  std::int64_t first_utime_us = 0;    // the first event's log timestamp: when the session started
+  std::uint64_t messages_skipped = 0; // events that did not decode as their channel's type
+  bool complete = true;               // the log ended exactly after an event
+  std::string notice;                 // why it is not complete (empty when it is)
+  std::vector<TipSample> tips;
+  std::vector<EventRecord> events;
+  std::vector<ScoreRecord> scores;
+  std::vector<CriteriaRecord> criteria;
+  std::vector<TotalsRecord> totals;
+  std::vector<ControlsRecord> controls;
+};
+
+// Reads the whole log (see above for what is an error and what a notice).
+SessionLog read_session_log(const std::string& path);
+
+}  // namespace vitreo::report

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# A trainee's history (vitreo-report --trainee ID ROOT): the sessions under ROOT that name the
+# trainee (DIR/trainee.txt, written by `vitreo --trainee ID`), per case in the order they started,
+# each attempt's total and categories equal to its own report.json, pass = a final score at or above
+# --pass; other trainees' and unnamed sessions left out; the page draws a learning curve per case in
+# headless Chromium without console errors; a bad id or no sessions give a clear error.
+set -euo pipefail
+report=$1 session=$2 vitreo=${3:-}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+log="$session/telemetry.lcmlog"
+size=$(stat -c %s "$log")
+# Three attempts of fellow-07: cut at 50 % and 75 % (running scores) and the whole session (final);
+# one of another trainee, one unnamed, one folder with a damaged report.
+mk() {  # mk FOLDER TRAINEE BYTES
+  mkdir -p "$work/root/$1"
+  head -c "$3" "$log" > "$work/root/$1/telemetry.lcmlog"
+  [ -z "$2" ] || echo "$2" > "$work/root/$1/trainee.txt"
+  "$report" "$work/root/$1" > /dev/null || [ $? -eq 3 ]
+}
+mk a-first fellow-07 $((size / 2))
+mk b-second fellow-07 $((size * 3 / 4))
+mk c-third fellow-07 "$size"
+mk d-other fellow-12 "$size"
+mk e-unnamed "" "$size"
+mkdir -p "$work/root/f-damaged" && echo '{"trainee": "fellow-07", "case": 3}' > "$work/root/f-damaged/report.json"
+python3 - "$work/root" <<'PY'
+# The attempts' start times come from the logs; cut copies of one log share it. Spread them so the
+# order is the folders' (an attempt's time is its first telemetry event's).
+import json, sys
+for i, name in enumerate(["c-third", "a-first", "b-second"]):
+    p = f"{sys.argv[1]}/{name}/report.json"
+    r = json.load(open(p))
+    r["case"]["started_utime_us"] = 1_800_000_000_000_000 + [3, 1, 2][i] * 86_400_000_000
+    json.dump(r, open(p, "w"))
+PY
+"$report" "$work/root" --trainee fellow-07 --pass 25 --generated "2026-01-01 00:00:00 UTC" > "$work/out.txt"
+grep -q "history of fellow-07: 3 sessions in 1 cases, 1 unreadable reports left out" "$work/out.txt"
+python3 - "$work/root" <<'PY'
+import json, sys
+root = sys.argv[1]
+h = json.load(open(f"{root}/history-fellow-07.json"))
+assert h["trainee"] == "fellow-07" and h["sessions"] == 3 and h["skipped_folders"] == 1, h
+(case,) = h["cases"]
+assert case["case"] == "exercise_pull_tissue"
+assert [a["folder"] for a in case["attempts"]] == ["a-first", "b-second", "c-third"], case["attempts"]
+for a in case["attempts"]:
+    r = json.load(open(f'{root}/{a["folder"]}/report.json'))
+    assert a["total"]["value"] == r["score"]["total"]["value"] and a["final"] == r["score"]["final"], (a, r["score"])
+    assert {k: v["value"] for k, v in a["categories"].items()} == {c["name"]: c["value"]["value"] for c in r["score"]["categories"]}
+    assert a["passed"] == (r["score"]["final"] and r["score"]["total"]["value"] >= 25)
+assert case["attempts"][2]["passed"] and not case["attempts"][0]["passed"], case["attempts"]
+assert case["first_passed_attempt"] == 3 and case["best"]["value"] == max(a["total"]["value"] for a in case["attempts"])
+print("history:", [(a["folder"], round(a["total"]["value"], 1), a["passed"]) for a in case["attempts"]])
+PY
+timeout 60 chromium --headless --no-sandbox --disable-gpu --no-first-run --user-data-dir="$work/profile" \
+  --proxy-server=127.0.0.1:9 --enable-logging=stderr --v=0 --virtual-time-budget=1000 \
+  --dump-dom "file://$work/root/history-fellow-07.html" > "$work/dom.html" 2> "$work/console.txt"
+if grep -E 'CONSOLE|Uncaught' "$work/console.txt"; then echo "console messages above"; exit 1; fi
+grep -q 'data-rendered="yes"' "$work/dom.html" && grep -q 'data-charts="1"' "$work/dom.html"
+grep -q '<canvas id="chart-case-0"[^>]*data-points="[1-9]' "$work/dom.html"
+grep -q 'passed at attempt 3' "$work/dom.html"
+
+set +e
+"$report" "$work/root" --trainee '../x' > /dev/null 2> "$work/err.txt"; rc1=$?
+"$report" "$work/root" --trainee nobody > /dev/null 2> "$work/err2.txt"; rc2=$?
+set -e
+[ $rc1 -eq 1 ] && grep -q "1-64 characters" "$work/err.txt"
+[ $rc2 -eq 1 ] && grep -q "no session of trainee 'nobody'" "$work/err2.txt"
+
+# The main job names the trainee: refused when the id is not one.
+if [ -n "$vitreo" ]; then
+  set +e; "$vitreo" --trainee 'a b' --out "$work/x" --duration 0.01 > /dev/null 2> "$work/err3.txt"; rc=$?; set -e
+  [ $rc -ne 0 ] && grep -q "1-64 characters" "$work/err3.txt"
+fi
+echo "history: ok"
