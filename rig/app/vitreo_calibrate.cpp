@@ -132,7 +132,9 @@ int main(int argc, char** argv) {
     }
     hub.start();
     hub.lockstep_connect();
-    for (std::size_t i = 0; i < hub.device_count(); ++i) rec.serials[hub.name(i)] = hub.announced_serial(i);
+    // The file names the units it calibrated (the eyeball fixture has no step of its own yet).
+    for (std::size_t i = 0; i < hub.device_count(); ++i)
+      if (proc.motion.count(hub.name(i))) rec.serials[hub.name(i)] = hub.announced_serial(i);
     const std::uint64_t steps = static_cast<std::uint64_t>(proc.duration_s * 1e6 / kStepUs);
     std::size_t next_step = 0;
     std::vector<const cal::ProcedureStep*> ordered;

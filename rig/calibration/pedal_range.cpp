@@ -6,14 +6,6 @@
 
 namespace vitreo::rig::calibration {
 
-double PedalRange::apply(double raw) const {
-  const double span = hi - lo;
-  if (!(span > 0.0) || !std::isfinite(raw)) return 0.0;
-  const double n = std::clamp((raw - lo) / span, 0.0, 1.0);
-  if (n <= dead_zone) return 0.0;
-  return dead_zone < 1.0 ? (n - dead_zone) / (1.0 - dead_zone) : 0.0;
-}
-
 namespace {
 double quantile(std::vector<double> v, double q) {  // by copy: nth_element reorders
   const std::size_t k = static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)));

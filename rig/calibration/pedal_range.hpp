@@ -8,7 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "rig/input/controls.hpp"
+
 namespace vitreo::rig::calibration {
+
+using rig::AxisRange;
 
 struct PedalRangeLimits {
   std::size_t min_rest_samples = 20;
@@ -17,12 +21,9 @@ struct PedalRangeLimits {
   double dead_zone_margin = 0.01;  // added to the rest jitter, of the range
 };
 
-struct PedalRange {
-  double lo = 0.0, hi = 1.0;    // raw readings at rest and fully pressed
-  double dead_zone = 0.0;       // of the normalised travel
-  // The raw reading mapped onto 0..1 with the dead zone removed.
-  double apply(double raw) const;
-};
+// lo, hi: raw readings at rest and fully pressed; dead_zone: of the normalised travel. The rig's
+// pedal mapping applies it (rig/input/controls.hpp), so the formula lives there once.
+using PedalRange = AxisRange;
 
 struct PedalRangeResult {
   bool ok = false;

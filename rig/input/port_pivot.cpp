@@ -22,7 +22,8 @@ bool map_through_port(const TrackedPose& tracked, const Port& port, const core::
   }
   // Rig frame → eye frame at rest → eye frame as the fixture has turned it.
   const core::Quat to_eye = eye_rotation.conjugate() * calibration.rig_to_eye;
-  const core::Vec3 tip = to_eye * (tracked.tip_mm - calibration.eye_center_in_rig_mm);
+  const core::Vec3 tip_in_rig = tracked.tip_mm + tracked.orientation * calibration.tip_offset_mm;
+  const core::Vec3 tip = to_eye * (tip_in_rig - calibration.eye_center_in_rig_mm);
   const core::Quat orientation = to_eye * tracked.orientation;
 
   InstrumentPose pose;

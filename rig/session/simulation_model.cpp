@@ -100,7 +100,9 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       if (!slot.frozen) {
         InstrumentPose pose;
         // In the fixture frame: the instrument system applies the eye's rotation itself.
-        ok = map_through_port(t.pose, case_->tracker_ports[t.instrument_id], core::Quat::Identity(), config_.calibration, pose);
+        const std::size_t i = static_cast<std::size_t>(t.instrument_id);
+        const Port& port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[t.instrument_id];
+        ok = map_through_port(t.pose, port, core::Quat::Identity(), config_.calibration[i], pose);
         if (ok) {
           slot.present = true;
           slot.port = t.instrument_id + 1;  // the eye's ports: 0 infusion, 1 working_1, 2 working_2
