@@ -244,3 +244,25 @@ TEST_F(CalibrationEndToEnd, ADeviceThatStopsMidwayFailsAndKeepsThePreviousCalibr
 
 }  // namespace
 }  // namespace vitreo::rig
+
+namespace vitreo::rig {
+namespace {
+
+TEST(RigFileCalibration, NamesTheFileRelativeToTheRigFileAndItsMaxAge) {
+  const std::string head = "[rig]\nversion = 1\n[[device]]\nname = \"t\"\nrole = \"tracker\"\nuri = \"sim:tracker?transport=pty\"\nid = 1\n";
+  const RigFile r = parse_rig_file(head + "[calibration]\nfile = \"cal/bench.toml\"\nmax_age_days = 14\n", "rig.toml", "/rigs");
+  EXPECT_EQ(r.calibration_path, "/rigs/cal/bench.toml");
+  ASSERT_TRUE(r.calibration_max_age_days);
+  EXPECT_EQ(*r.calibration_max_age_days, 14.0);
+  EXPECT_TRUE(parse_rig_file(head, "rig.toml", "/rigs").calibration_path.empty());
+  try {
+    parse_rig_file(head + "[calibration]\nfile = \"x.toml\"\nmax_age_days = -3\n", "rig.toml", "/rigs");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("rig.toml:10: calibration.max_age_days"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_rig_file(head + "[calibration]\nmax_age_days = 3\n", "rig.toml", "/rigs"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace vitreo::rig
