@@ -22,7 +22,7 @@ calibration::CalibrationFile apply_calibration(const std::string& text, const st
 struct CalibrationLoad {
   calibration::CalibrationFile file;
   std::vector<std::string> notes;     // what was applied, for the log
-  std::vector<std::string> warnings;  // a stale calibration, a port far from the case's
+  std::vector<std::string> warnings;  // a stale calibration
 };
 
 // For the rig at start: reads `path`, refuses it (std::runtime_error, model and devices unchanged)
