@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
   std::string rig_path;
   std::string calibration_path;
   double calibration_max_age_days = -1.0;  // unset: the rig file's, else 30
+  std::string calibration_in_force = "none (uncalibrated input mapping)";  // for the summary
   std::string script_path;
   bool idle = false;
   std::vector<std::string> serial_devices;
@@ -343,6 +344,8 @@ int main(int argc, char** argv) {
           calibration_max_age_days > 0.0 ? calibration_max_age_days : vitreo::rig::kDefaultCalibrationMaxAgeDays, now_s);
       for (const auto& n : load.notes) spdlog::info("{}", n);
       for (const auto& w : load.warnings) spdlog::warn("{}", w);
+      calibration_in_force = calibration_path + " (" + vitreo::rig::calibration_id(load.file) + ")" +
+                             (load.warnings.empty() ? "" : " — " + load.warnings.front());
       config.model = model;
     }
     config.devices = devices;
@@ -402,6 +405,7 @@ int main(int argc, char** argv) {
     std::printf("  instruments      %s\n", s.instruments.c_str());
     std::printf("  script           %s%s%s\n", script.file.empty() ? "none (idle)" : script.file.c_str(),
                 script.file.empty() ? "" : (" (" + script.kind + ")").c_str(), script.summary.empty() ? "" : (": " + script.summary).c_str());
+    std::printf("  calibration      %s\n", calibration_in_force.c_str());
     for (const auto& line : s.cases_loaded) std::printf("  case loaded      %s\n", line.c_str());
     std::printf("  simulated        %.3f s in %llu steps (%s)\n", s.simulated_s, static_cast<unsigned long long>(s.steps),
                 s.stop_reason == "duration reached" ? "the whole duration" : ("stopped early by " + s.stop_reason).c_str());
