@@ -134,6 +134,10 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
       double hi = 0;
       if (!num(3, hi) || b < 0 || hi > 1 || !(hi > b)) return fail("pedal_range needs 0 <= LO < HI <= 1");
       s.imperfect.pedal_lo[static_cast<int>(a)] = b, s.imperfect.pedal_hi[static_cast<int>(a)] = hi;
+    } else if (word == "eye_zero") {
+      if (!exactly(3, "eye_zero YAW PITCH") || !num(1, a) || !num(2, b) || std::fabs(a) > 90 || std::fabs(b) > 90)
+        return fail("eye_zero needs a yaw and a pitch in degrees (-90..90)");
+      s.imperfect.eye_zero_deg[0] = a, s.imperfect.eye_zero_deg[1] = b;
     } else if (word == "clock_offset_ms") {
       // The device clock must not go below zero: it has been up kBootUs (5 s) when the link starts.
       if (!exactly(2, "clock_offset_ms X") || !num(1, a) || a < -4000 || a > 1e9) return fail("clock_offset_ms must be -4000..1e9");
@@ -371,6 +375,11 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       std::normal_distribution<double> angle(0.0, 0.01 * s_.noise), depth(0.0, 0.002 * s_.noise);
       const double jy = s_.noise > 0 ? angle(noise_rng_) : 0.0, jp = s_.noise > 0 ? angle(noise_rng_) : 0.0, jr = s_.noise > 0 ? angle(noise_rng_) : 0.0;
       auto q = quat_from_euler_deg(v[0] + jy, v[1] + jp, jr);
+      if (s_.imperfect.eye_zero_deg[0] != 0 || s_.imperfect.eye_zero_deg[1] != 0) {
+        const std::array<float, 4> zf = quat_from_euler_deg(s_.imperfect.eye_zero_deg[0], s_.imperfect.eye_zero_deg[1], 0.0);
+        const std::array<double, 4> zq = multiply({zf[0], zf[1], zf[2], zf[3]}, {q[0], q[1], q[2], q[3]});
+        for (int i = 0; i < 4; ++i) q[static_cast<std::size_t>(i)] = static_cast<float>(zq[static_cast<std::size_t>(i)]);
+      }
       for (int i = 0; i < 4; ++i) p.q_wxyz[i] = q[static_cast<std::size_t>(i)];
       p.port_count = 3;
       for (int i = 0; i < 3; ++i) {

@@ -45,6 +45,8 @@ struct FaultEvent {
 //                                     keys' frame): reported = R·true + t (degrees, mm)
 //   pedal_range AXIS LO HI            pedals: the potentiometer reads LO at rest and HI fully down
 //   clock_offset_ms X  clock_drift_ppm Y   the device clock's extra offset and rate error
+//   eye_zero YAW PITCH                eyeball: what the fixture reads with the eye at rest (degrees):
+//                                     reported = zero · true
 // ("noise 10" gives the 0.05 mm of tracker noise.)
 struct Imperfections {
   double tip_offset_mm[3] = {0, 0, 0};
@@ -52,6 +54,7 @@ struct Imperfections {
   double frame_t_mm[3] = {0, 0, 0};
   double pedal_lo[2] = {0, 0}, pedal_hi[2] = {1, 1};
   double clock_offset_ms = 0, clock_drift_ppm = 0;
+  double eye_zero_deg[2] = {0, 0};
   bool tracker_any() const;
   bool clock_any() const { return clock_offset_ms != 0 || clock_drift_ppm != 0; }
 };

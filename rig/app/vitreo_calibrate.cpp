@@ -94,15 +94,16 @@ int main(int argc, char** argv) {
   }
 
   std::vector<cal::TrackerRole> trackers;
-  std::string pedals;
+  std::string pedals, eyeball;
   for (const DeviceSpec& d : rig.devices) {
     if (d.role == DeviceRole::tracker) trackers.push_back({d.name, d.channel});
     if (d.role == DeviceRole::pedals && pedals.empty()) pedals = d.name;
+    if (d.role == DeviceRole::eyeball && eyeball.empty()) eyeball = d.name;
   }
   // Instrument 0 (the tool hand) registers and measures the ports when present.
   std::stable_sort(trackers.begin(), trackers.end(), [](const auto& a, const auto& b) { return a.instrument < b.instrument; });
   const cal::Fixture fixture = cal::default_fixture();
-  const cal::Procedure proc = cal::plan_procedure(fixture, trackers, pedals);
+  const cal::Procedure proc = cal::plan_procedure(fixture, trackers, pedals, eyeball);
 
   std::vector<DeviceSpec> specs = rig.devices;
   std::map<std::int32_t, std::string> name_of;
@@ -132,7 +133,7 @@ int main(int argc, char** argv) {
     }
     hub.start();
     hub.lockstep_connect();
-    // The file names the units it calibrated (the eyeball fixture has no step of its own yet).
+    // The file names the units it calibrated.
     for (std::size_t i = 0; i < hub.device_count(); ++i)
       if (proc.motion.count(hub.name(i))) rec.serials[hub.name(i)] = hub.announced_serial(i);
     const std::uint64_t steps = static_cast<std::uint64_t>(proc.duration_s * 1e6 / kStepUs);
@@ -152,6 +153,8 @@ int main(int argc, char** argv) {
         const std::string& name = name_of[in.device_id];
         if (vitreo::rig::DecodedTracker t; vitreo::rig::decode_tracker(in, t)) {
           rec.poses[name].push_back({t_s, t.pose.tip_mm, t.pose.orientation});
+        } else if (vitreo::rig::DecodedEyeball e; vitreo::rig::decode_eyeball(in, e)) {
+          rec.eyeball[name].push_back({t_s, e.orientation});
         } else if (vitreo::rig::PedalReading p; vitreo::rig::decode_pedals(in, p)) {
           rec.pedals[name].push_back({t_s, p.pedal_id, {p.axes[0], p.axes[1]}});
         } else if (in.device_kind == vitreo::rig::kLinkKind && in.n_values >= 1 &&

@@ -191,6 +191,12 @@ std::string format_calibration(const CalibrationFile& c) {
     s += "\n[[pedal]]\npedal = " + std::to_string(p.pedal) + "\naxis = " + std::to_string(p.axis) + "\n";
     s += "lo = " + num(p.range.lo, 6) + "\nhi = " + num(p.range.hi, 6) + "\ndead_zone = " + num(p.range.dead_zone, 6) + "\n";
   }
+  if (c.eye_zero) {
+    const core::Quat q = c.eye_zero->zero.normalized();
+    s += "\n[eyeball]  # the fixture's reading with the eye at rest: the rig's zero\n";
+    s += "zero_wxyz = [" + num(q.w(), 12) + ", " + num(q.x(), 12) + ", " + num(q.y(), 12) + ", " + num(q.z(), 12) + "]\n";
+    s += "samples = " + std::to_string(c.eye_zero->samples) + "\nspread_deg = " + num(c.eye_zero->spread_deg, 4) + "\n";
+  }
   for (const ClockRecord& k : c.clocks) {
     s += "\n[[clock]]\ndevice = " + quoted(k.device) + "\noffset_ms = " + num(k.offset_ms, 6) + "\n";
     s += "drift_ppm = " + num(k.drift_ppm, 3) + "\nlatency_ms = " + num(k.latency_ms, 6) + "\nrms_ms = " + num(k.rms_ms, 6) + "\n";
@@ -295,6 +301,19 @@ CalibrationFile parse_calibration(const std::string& text, const std::string& or
     t.no_others("pedal, axis, lo, hi, dead_zone");
     c.pedals.push_back(r);
   });
+  if (const toml::node* n = root.get("eyeball")) {
+    if (!n->as_table()) fail_at(*n, "eyeball", "must be a table");
+    TableReader t(*n->as_table(), origin, "eyeball");
+    EyeZeroRecord r;
+    const Eigen::VectorXd q = t.numbers("zero_wxyz", 4, -1.0, 1.0);
+    r.zero = core::Quat(q(0), q(1), q(2), q(3));
+    if (std::abs(r.zero.norm() - 1.0) > 1e-6) t.fail(t.need("zero_wxyz"), t.key("zero_wxyz"), "must be a unit quaternion");
+    r.zero.normalize();
+    r.samples = static_cast<std::size_t>(t.integer("samples", 0, 100'000'000));
+    r.spread_deg = t.number("spread_deg", 0.0, 180.0);
+    t.no_others("zero_wxyz, samples, spread_deg");
+    c.eye_zero = r;
+  }
   each("clock", [&](TableReader& t) {
     ClockRecord r;
     r.device = t.string("device");
@@ -308,8 +327,8 @@ CalibrationFile parse_calibration(const std::string& text, const std::string& or
   for (const auto& [k, v] : root) {
     const std::string key(k.str());
     if (key != "calibration" && key != "device" && key != "registration" && key != "instrument" && key != "port" &&
-        key != "pedal" && key != "clock")
-      fail_at(v, key, "unknown table (calibration, device, registration, instrument, port, pedal, clock)");
+        key != "pedal" && key != "eyeball" && key != "clock")
+      fail_at(v, key, "unknown table (calibration, device, registration, instrument, port, pedal, eyeball, clock)");
   }
   return c;
 }

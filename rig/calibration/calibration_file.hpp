@@ -52,6 +52,12 @@ struct PedalRecord {
   PedalRange range;
 };
 
+struct EyeZeroRecord {  // the eyeball fixture's reading with the eye at rest
+  core::Quat zero = core::Quat::Identity();
+  std::size_t samples = 0;
+  double spread_deg = 0.0;
+};
+
 struct ClockRecord {
   std::string device;
   double offset_ms = 0.0, drift_ppm = 0.0, latency_ms = 0.0, rms_ms = 0.0;
@@ -66,6 +72,7 @@ struct CalibrationFile {
   std::vector<InstrumentRecord> instruments;
   std::vector<PortRecord> ports;
   std::vector<PedalRecord> pedals;
+  std::optional<EyeZeroRecord> eye_zero;
   std::vector<ClockRecord> clocks;
 
   const InstrumentRecord* instrument(int channel) const;

@@ -43,7 +43,8 @@ void tracker_key(std::string& out, double t_s, const core::Vec3& p, double yaw, 
 
 }  // namespace
 
-Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals) {
+Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
+                         const std::string& eyeball) {
   Procedure proc;
   double end = 0.0;
   // Pivoting: a widening spiral of the shaft about the tip in the divot (two directions, so the
@@ -98,9 +99,15 @@ Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>&
     }
     end = std::max(end, 6.5);
   }
+  if (!eyeball.empty()) {
+    // The eye is left in its rest position at the start: what the fixture reads then is its zero.
+    proc.motion[eyeball] = "key 0 0 0 0 0 0\n";
+    proc.steps.push_back({StepKind::eye_zero, eyeball, 0, 0.3, 1.4, "leave the eye in its rest position"});
+  }
   proc.duration_s = end + 0.5;
   for (const TrackerRole& t : trackers) proc.steps.push_back({StepKind::clock, t.device, 0, 0.0, proc.duration_s, "keep the devices connected"});
-  if (!pedals.empty()) proc.steps.push_back({StepKind::clock, pedals, 0, 0.0, proc.duration_s, "keep the devices connected"});
+  for (const std::string& d : {pedals, eyeball})
+    if (!d.empty()) proc.steps.push_back({StepKind::clock, d, 0, 0.0, proc.duration_s, "keep the devices connected"});
   return proc;
 }
 
@@ -211,6 +218,32 @@ Analysis analyse(const Procedure& proc, const Fixture& fixture, const Recording&
         outcome(s, r.ok, r.ok ? fb : r.error);
         break;
       }
+      case StepKind::eye_zero: {
+        const auto it = rec.eyeball.find(s.device);
+        std::vector<TimedOrientation> samples = in_window(it == rec.eyeball.end() ? std::vector<TimedOrientation>{} : it->second,
+                                                          s.start_s, s.end_s);
+        if (samples.size() < limits.eye_zero.min_samples) {
+          outcome(s, false, "only " + std::to_string(samples.size()) + " samples at rest (need " +
+                                std::to_string(limits.eye_zero.min_samples) + "): did the fixture stop?");
+          break;
+        }
+        // The mean of nearby unit quaternions: their sign-aligned sum, normalised (accurate to
+        // second order in the spread, which is checked to be small).
+        Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+        const Eigen::Vector4d first = samples.front().orientation.coeffs();
+        for (const TimedOrientation& o : samples) sum += o.orientation.coeffs().dot(first) < 0 ? -o.orientation.coeffs() : o.orientation.coeffs();
+        core::Quat mean;
+        mean.coeffs() = sum.normalized();
+        double spread = 0.0;
+        for (const TimedOrientation& o : samples) spread = std::max(spread, mean.angularDistance(o.orientation) * 180.0 / std::numbers::pi);
+        const Eigen::AngleAxisd aa(mean);
+        const std::string fb = std::to_string(samples.size()) + " samples, zero " + fixed(aa.angle() * 180.0 / std::numbers::pi, 3) +
+                               "° from the fixture's, still within " + fixed(spread, 3) + "°";
+        const bool still = spread <= limits.eye_zero.max_spread_deg;
+        if (still) a.file.eye_zero = EyeZeroRecord{mean, samples.size(), spread};
+        outcome(s, still, still ? fb : "the eye moved: " + fb);
+        break;
+      }
       case StepKind::clock: {
         const auto it = rec.clocks.find(s.device);
         const ClockResult r = estimate_clock(it == rec.clocks.end() ? std::vector<TimeSyncExchange>{} : it->second, limits.clock);
@@ -277,6 +310,9 @@ std::string summary_text(const Analysis& a) {
   for (const PedalRecord& p : f.pedals)
     s += "  pedal " + std::to_string(p.pedal) + " axis " + std::to_string(p.axis) + ": " + (fixed(p.range.lo, 3)) + " .. " +
          (fixed(p.range.hi, 3)) + ", dead zone " + (fixed(p.range.dead_zone, 3)) + "\n";
+  if (f.eye_zero)
+    s += "  eyeball zero: " + fixed(Eigen::AngleAxisd(f.eye_zero->zero).angle() * 180.0 / std::numbers::pi, 3) +
+         "° from the fixture's own, still within " + fixed(f.eye_zero->spread_deg, 3) + "°\n";
   for (const ClockRecord& c : f.clocks)
     s += "  clock " + c.device + ": offset " + (fixed(c.offset_ms, 3) + " ms") + ", drift " + (fixed(c.drift_ppm, 1) + " ppm") +
          ", latency " + (fixed(c.latency_ms, 3) + " ms") + "\n";

@@ -34,7 +34,7 @@ struct Fixture {
 // ports 3.5 mm behind the limbus at 10 and 2 o'clock of a 12 mm globe.
 Fixture default_fixture();
 
-enum class StepKind { pivot, fiducial, port, pedal_rest, pedal_travel, clock };
+enum class StepKind { pivot, fiducial, port, pedal_rest, pedal_travel, eye_zero, clock };
 
 struct ProcedureStep {
   StepKind kind = StepKind::pivot;
@@ -57,8 +57,9 @@ struct Procedure {
 };
 
 // trackers: every tracker pivots; the first one (instrument 0 where present) also registers and
-// measures the ports. pedals: the pedal device's name, empty for none.
-Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals);
+// measures the ports. pedals, eyeball: the devices' names, empty for none.
+Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
+                         const std::string& eyeball = {});
 
 // What a run recorded, by device name, with session times in seconds.
 struct TimedPose {
@@ -71,8 +72,13 @@ struct TimedPedal {
   int pedal_id = 0;
   double axes[2] = {0.0, 0.0};
 };
+struct TimedOrientation {
+  double t_s = 0.0;
+  core::Quat orientation = core::Quat::Identity();
+};
 struct Recording {
   std::map<std::string, std::vector<TimedPose>> poses;
+  std::map<std::string, std::vector<TimedOrientation>> eyeball;
   std::map<std::string, std::vector<TimedPedal>> pedals;
   std::map<std::string, std::vector<TimeSyncExchange>> clocks;
   std::map<std::string, std::uint32_t> serials;
@@ -84,7 +90,13 @@ struct StepOutcome {
   std::string feedback;  // "412 samples, spread 38.0°, RMS 0.041 mm"
 };
 
+struct EyeZeroLimits {
+  std::size_t min_samples = 20;
+  double max_spread_deg = 0.5;  // the eye was left alone: its readings stay within this of their mean
+};
+
 struct Limits {
+  EyeZeroLimits eye_zero;
   PivotLimits pivot;
   RegistrationLimits registration;
   PortLimits port;

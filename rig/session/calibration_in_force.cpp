@@ -21,6 +21,7 @@ calibration::CalibrationFile apply_calibration(const std::string& text, const st
     if (const calibration::InstrumentRecord* r = c.instrument(static_cast<int>(i))) t.tip_offset_mm = r->tip_offset_mm;
     if (const calibration::PortRecord* p = c.port(static_cast<int>(i))) out.measured_ports[i] = Port{p->position_mm, p->outward};
   }
+  out.eye_zero = c.eye_zero ? c.eye_zero->zero : core::Quat::Identity();
   out.pedals.axis_ranges.clear();
   for (const calibration::PedalRecord& p : c.pedals) {
     AxisRange r = p.range;

@@ -2,8 +2,8 @@
 // The rig's sensor calibration in force: a calibration file (rig/calibration/calibration_file.hpp,
 // written by vitreo-calibrate) applied to the input mapping — the tracker-to-eye registration and
 // each instrument's tip offset (TrackerCalibration), the ports measured on the fixture, the pedals'
-// ranges and dead zones (PedalMapping::axis_ranges). `vitreo --calibration FILE` or the rig file's
-// [calibration] file.
+// ranges and dead zones (PedalMapping::axis_ranges), the eyeball fixture's rest reading
+// (ModelConfig::eye_zero). `vitreo --calibration FILE` or the rig file's [calibration] file.
 #include <cstdint>
 #include <string>
 #include <vector>

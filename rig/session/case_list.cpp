@@ -72,6 +72,7 @@ void decode_case_list(const std::string& text, ModelConfig& config) {
   out.calibration = {};
   out.measured_ports = {};
   out.calibration_text.clear();
+  out.eye_zero = core::Quat::Identity();
   out.pedals.axis_ranges.clear();
   long long first_case = 0;
   constexpr long long kMaxCases = 4096;

@@ -123,7 +123,11 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
   } else if (DecodedEyeball e; decode_eyeball(in, e)) {
     const double n = e.orientation.coeffs().norm();
     if (std::abs(n - 1.0) < 1e-3) {
-      eye_rotation_ = e.orientation.normalized();
+      // Relative to the calibrated rest reading; skipped when there is none, so uncalibrated
+      // sessions keep their bits.
+      eye_rotation_ = config_.eye_zero.coeffs() == core::Quat::Identity().coeffs()
+                          ? e.orientation.normalized()
+                          : (config_.eye_zero.conjugate() * e.orientation.normalized()).normalized();
       eye_tracked_ = true;
       ok = true;
     }

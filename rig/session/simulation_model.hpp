@@ -53,6 +53,7 @@ struct ModelConfig {
   // force (empty: none), carried by the recording so a replay maps the inputs the same way.
   std::array<TrackerCalibration, kTrackedInstruments> calibration{};
   std::array<std::optional<Port>, kTrackedInstruments> measured_ports{};
+  core::Quat eye_zero = core::Quat::Identity();  // the fixture's reading with the eye at rest
   std::string calibration_text;
   core::MicroscopeSettings microscope;
 };

@@ -93,6 +93,13 @@ TEST(EmulatorImperfections, ClockOffsetAndDriftShowInTimeSync) {
   EXPECT_TRUE(found);
 }
 
+TEST(EmulatorImperfections, EyeballReadsItsZeroOffsetAtRest) {
+  FirmwareEmulator emu(parse("device eyeball\nnoise 0\nloop 0\nkey 0 10 0 0 0 0\neye_zero 6 -4\n"));
+  const vp_message m = first_sample(emu, VP_MSG_EYEBALL_STATE);
+  const Eigen::Quaterniond got(m.u.eyeball.q_wxyz[0], m.u.eyeball.q_wxyz[1], m.u.eyeball.q_wxyz[2], m.u.eyeball.q_wxyz[3]);
+  EXPECT_LT(got.angularDistance(ypr(6, -4, 0) * ypr(10, 0, 0)), 1e-5);
+}
+
 TEST(EmulatorImperfections, BadDirectivesAreRefusedWithTheirLine) {
   Script s;
   std::string err;

@@ -109,16 +109,27 @@ TEST_F(CalibrationEndToEnd, RecoversEveryInjectedImperfectionWithinTheIssuesTole
   // Clocks: both devices share the emulators' start and boot time, so their offsets differ by the
   // injected offsets plus the injected drifts accumulated by the fit's reference time (the run's
   // end, 20.5 ± 0.5 s in, so ±0.1 ms of uncertainty from the 210 ppm difference).
-  ASSERT_EQ(c.clocks.size(), 2u);
-  const calibration::ClockRecord& tracker = c.clocks[0].device == "tracker-0" ? c.clocks[0] : c.clocks[1];
-  const calibration::ClockRecord& pedals = c.clocks[0].device == "tracker-0" ? c.clocks[1] : c.clocks[0];
+  ASSERT_EQ(c.clocks.size(), 3u);  // tracker, pedals, eyeball
+  auto clock_of = [&](const std::string& name) {
+    for (const calibration::ClockRecord& r : c.clocks)
+      if (r.device == name) return r;
+    ADD_FAILURE() << "no clock for " << name;
+    return calibration::ClockRecord{};
+  };
+  const calibration::ClockRecord tracker = clock_of("tracker-0"), pedals = clock_of("pedals");
   const double expected_difference_ms = (123.4 - -40.0) + (150.0 - -60.0) * 1e-6 * 20.5e3;
   const double clock_error = std::abs((tracker.offset_ms - pedals.offset_ms) - expected_difference_ms);
   EXPECT_LT(clock_error, 0.5);
   EXPECT_NEAR(tracker.drift_ppm - pedals.drift_ppm, 210.0, 10.0);
+  // The eyeball fixture's rest reading (calibration-eyeball.sim: yaw 6°, pitch −4°) within 0.1°.
+  ASSERT_TRUE(c.eye_zero);
+  const double d = std::numbers::pi / 180.0;
+  const core::Quat eye_zero_truth(Eigen::AngleAxisd(6 * d, core::Vec3::UnitZ()) * Eigen::AngleAxisd(-4 * d, core::Vec3::UnitY()));
+  const double eye_zero_error_deg = c.eye_zero->zero.angularDistance(eye_zero_truth) / d;
+  EXPECT_LT(eye_zero_error_deg, 0.1);
   std::printf("recovered: tip %.4f mm (0.1), TRE %.4f mm (0.2), ports %.4f mm (0.2), pedals %.2f %% (2), "
-              "clock %.3f ms (0.5); drift %.1f and %.1f ppm (150, -60 injected)\n",
-              tip_error, tre, port_error, 100 * pedal_error, clock_error, tracker.drift_ppm, pedals.drift_ppm);
+              "clock %.3f ms (0.5); drift %.1f and %.1f ppm (150, -60 injected); eye zero %.4f deg\n",
+              tip_error, tre, port_error, 100 * pedal_error, clock_error, tracker.drift_ppm, pedals.drift_ppm, eye_zero_error_deg);
 }
 
 // Plays a tracker with the injected imperfections through a pty in lockstep, holding its tip at
@@ -154,10 +165,12 @@ TEST_F(CalibrationEndToEnd, TheCalibratedRigMapsTheInstrumentWhereItIs) {
   ASSERT_EQ(run_.status, 0) << run_.output;
   ModelConfig calibrated, plain;
   std::vector<DeviceSpec> devices = {{"tracker-0", DeviceRole::tracker, "sim:tracker?transport=pty", 1, 0, 0, 0, {}},
-                                     {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, {}}};
+                                     {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, {}},
+                                     {"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, 0, {}}};
   const CalibrationLoad load = load_calibration(file_, devices, calibrated, 30.0, ::time(nullptr));
   EXPECT_TRUE(load.warnings.empty());
   EXPECT_EQ(devices[0].expected_serial, 1001u);  // pinned to the calibrated unit
+  EXPECT_GT(calibrated.eye_zero.angularDistance(core::Quat::Identity()), 0.1);  // the fixture's 7° rest reading
   // A tip 3 mm inside port 0, tilted: where the rig puts it with and without the calibration.
   const core::Vec3 truth = true_port(0) - 3.0 * true_port(0).normalized();
   // Averaged over 100 samples (0.1 s), so the check is of the mapping, not of one sample's noise.
@@ -207,6 +220,7 @@ TEST_F(CalibrationEndToEnd, IsRefusedForOtherSerialsAndItsRecordingCarriesIt) {
   // A stale one is applied with a warning.
   devices[0].expected_serial = 0;
   devices.push_back({"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, 0, {}});
+  devices.push_back({"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, 0, {}});
   const CalibrationLoad old = load_calibration(file_, devices, model, 30.0, ::time(nullptr) + 40 * 86400);
   ASSERT_EQ(old.warnings.size(), 1u);
   EXPECT_NE(old.warnings[0].find("days old"), std::string::npos);
@@ -223,10 +237,8 @@ TEST_F(CalibrationEndToEnd, ADeviceThatStopsMidwayFailsAndKeepsThePreviousCalibr
   ASSERT_EQ(run_.status, 0) << run_.output;
   // The same rig, but the tracker's cable is pulled 9 s in (while touching the fiducials).
   const fs::path rig = dir_ / "stops.toml";
-  fs::create_directories(dir_ / "sim");
-  fs::copy_file(kSource + "/rig/config/sim/calibration-pedals.sim", dir_ / "sim/calibration-pedals.sim");
-  std::ifstream t(kSource + "/rig/config/sim/calibration-tracker.sim");
-  std::ofstream(dir_ / "sim/calibration-tracker.sim") << t.rdbuf() << "fault 9000 60000 disconnect\n";
+  fs::copy(kSource + "/rig/config/sim", dir_ / "sim", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  std::ofstream(dir_ / "sim/calibration-tracker.sim", std::ios::app) << "fault 9000 60000 disconnect\n";
   std::ifstream r(kSource + "/rig/config/sim-calibration.toml");
   std::ofstream(rig) << r.rdbuf();
   const std::string previous = (dir_ / "previous.toml").string();

@@ -66,6 +66,11 @@ offset_ms = -2999987.655
 drift_ppm = 80.0
 latency_ms = 0.13
 rms_ms = 0.004
+
+[eyeball]
+zero_wxyz = [0.6, 0.8, 0.0, 0.0]
+samples = 1100
+spread_deg = 0.04
 )";
 
 TEST(CalibrationFile, ReadsTheDocumentedFormat) {
@@ -88,6 +93,9 @@ TEST(CalibrationFile, ReadsTheDocumentedFormat) {
   EXPECT_DOUBLE_EQ(c.pedal(0, 1)->range.hi, 0.91);
   ASSERT_EQ(c.clocks.size(), 1u);
   EXPECT_DOUBLE_EQ(c.clocks[0].offset_ms, -2999987.655);
+  ASSERT_TRUE(c.eye_zero);
+  EXPECT_NEAR(c.eye_zero->zero.angularDistance(core::Quat(0.6, 0.8, 0.0, 0.0)), 0.0, 1e-12);
+  EXPECT_EQ(c.eye_zero->samples, 1100u);
 }
 
 TEST(CalibrationFile, UtcTimestampsMatchTheCivilCalendar) {
@@ -142,7 +150,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Bad{"rms_ms = 0.004", "rms_ms = 0.004\n[extra]", "cal.toml:51: extra: unknown table"},
                       Bad{"rig = \"bench 2\"", "rig = \"bench 2", "cal.toml:6:"},
                       Bad{"name = \"pedals\"", "name = \"tracker\"", "cal.toml:13: device[1].name: 'tracker' is listed twice"},
-                      Bad{"[calibration]", "[calibrat]", "cal.toml:1: calibration: no [calibration] table"}));
+                      Bad{"[calibration]", "[calibrat]", "cal.toml:1: calibration: no [calibration] table"},
+                      Bad{"zero_wxyz = [0.6, 0.8, 0.0, 0.0]", "zero_wxyz = [0.6, 0.6, 0.0, 0.0]", "cal.toml:53: eyeball.zero_wxyz: must be a unit"}));
 
 TEST(CalibrationFile, RefusesOtherDevicesSerials) {
   const CalibrationFile c = parse_calibration(kExample, "x.toml");
