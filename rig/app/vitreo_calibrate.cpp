@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -112,8 +113,13 @@ int main(int argc, char** argv) {
     d.sim_script = technician_script(d, m == proc.motion.end() ? std::string() : m->second);
     name_of[d.device_id] = d.name;
     if (!motion_dir.empty()) {
-      std::filesystem::create_directories(motion_dir);
-      std::ofstream(std::filesystem::path(motion_dir) / (d.name + ".sim")) << d.sim_script;
+      std::error_code ec;
+      std::filesystem::create_directories(motion_dir, ec);
+      std::ofstream f(std::filesystem::path(motion_dir) / (d.name + ".sim"));
+      if (!(f << d.sim_script) || !f.flush()) {
+        std::fprintf(stderr, "vitreo-calibrate: --save-motion: cannot write %s/%s.sim\n", motion_dir.c_str(), d.name.c_str());
+        return 2;
+      }
     }
   }
 
