@@ -23,12 +23,13 @@ PedalRangeResult measure_pedal_range(const std::vector<double>& rest, const std:
         r.error = "a pedal reading is not finite";
         return r;
       }
-  if (rest.size() < limits.min_rest_samples) {
+  // At least one sample each whatever the limits say: the quantiles below need one.
+  if (rest.size() < std::max<std::size_t>(limits.min_rest_samples, 1)) {
     r.error = "too few readings at rest: " + std::to_string(rest.size()) + " (need " +
               std::to_string(limits.min_rest_samples) + "); leave the pedal alone a little longer";
     return r;
   }
-  if (travel.size() < limits.min_travel_samples) {
+  if (travel.size() < std::max<std::size_t>(limits.min_travel_samples, 1)) {
     r.error = "too few readings over the travel: " + std::to_string(travel.size()) + " (need " +
               std::to_string(limits.min_travel_samples) + ")";
     return r;
