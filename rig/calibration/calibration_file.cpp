@@ -130,6 +130,13 @@ class TableReader {
     return v;
   }
   core::Vec3 vec3(std::string_view k, double limit) { return numbers(k, 3, -limit, limit); }
+  // [w, x, y, z], unit length (to 1e-6: the file keeps 12 decimals), normalised.
+  core::Quat unit_quaternion(std::string_view k) {
+    const Eigen::VectorXd q = numbers(k, 4, -1.0, 1.0);
+    const core::Quat out(q(0), q(1), q(2), q(3));
+    if (std::abs(out.norm() - 1.0) > 1e-6) fail(need(k), key(k), "must be a unit quaternion");
+    return out.normalized();
+  }
   // Unknown keys are errors: a misspelt key must not silently leave a default in force.
   void no_others(const std::string& allowed) const {
     for (const auto& [k, v] : t_)
@@ -250,14 +257,16 @@ CalibrationFile parse_calibration(const std::string& text, const std::string& or
     c.devices.push_back(d);
     t.no_others("name, serial");
   });
-  if (const toml::node* n = root.get("registration")) {
-    if (!n->as_table()) fail_at(*n, "registration", "must be a table");
-    TableReader t(*n->as_table(), origin, "registration");
+  auto table = [&](const char* name, const std::function<void(TableReader&)>& read) {
+    const toml::node* n = root.get(name);
+    if (!n) return;
+    if (!n->as_table()) fail_at(*n, name, "must be a table");
+    TableReader t(*n->as_table(), origin, name);
+    read(t);
+  };
+  table("registration", [&](TableReader& t) {
     RegistrationRecord r;
-    const Eigen::VectorXd q = t.numbers("rig_to_eye_wxyz", 4, -1.0, 1.0);
-    r.rig_to_eye = core::Quat(q(0), q(1), q(2), q(3));
-    if (std::abs(r.rig_to_eye.norm() - 1.0) > 1e-6) t.fail(t.need("rig_to_eye_wxyz"), t.key("rig_to_eye_wxyz"), "must be a unit quaternion");
-    r.rig_to_eye.normalize();
+    r.rig_to_eye = t.unit_quaternion("rig_to_eye_wxyz");
     r.eye_center_in_rig_mm = t.vec3("eye_center_in_rig_mm", 5000.0);
     r.fiducials = static_cast<std::size_t>(t.integer("fiducials", 3, 1000));
     r.fre_mm = t.number("fre_mm", 0.0, 100.0);
@@ -265,7 +274,7 @@ CalibrationFile parse_calibration(const std::string& text, const std::string& or
     r.tre_measured = t.boolean("tre_measured");
     t.no_others("rig_to_eye_wxyz, eye_center_in_rig_mm, fiducials, fre_mm, tre_mm, tre_measured");
     c.registration = r;
-  }
+  });
   each("instrument", [&](TableReader& t) {
     InstrumentRecord r;
     r.instrument = static_cast<int>(t.integer("instrument", 0, 255));
@@ -301,19 +310,14 @@ CalibrationFile parse_calibration(const std::string& text, const std::string& or
     t.no_others("pedal, axis, lo, hi, dead_zone");
     c.pedals.push_back(r);
   });
-  if (const toml::node* n = root.get("eyeball")) {
-    if (!n->as_table()) fail_at(*n, "eyeball", "must be a table");
-    TableReader t(*n->as_table(), origin, "eyeball");
+  table("eyeball", [&](TableReader& t) {
     EyeZeroRecord r;
-    const Eigen::VectorXd q = t.numbers("zero_wxyz", 4, -1.0, 1.0);
-    r.zero = core::Quat(q(0), q(1), q(2), q(3));
-    if (std::abs(r.zero.norm() - 1.0) > 1e-6) t.fail(t.need("zero_wxyz"), t.key("zero_wxyz"), "must be a unit quaternion");
-    r.zero.normalize();
+    r.zero = t.unit_quaternion("zero_wxyz");
     r.samples = static_cast<std::size_t>(t.integer("samples", 0, 100'000'000));
     r.spread_deg = t.number("spread_deg", 0.0, 180.0);
     t.no_others("zero_wxyz, samples, spread_deg");
     c.eye_zero = r;
-  }
+  });
   each("clock", [&](TableReader& t) {
     ClockRecord r;
     r.device = t.string("device");
