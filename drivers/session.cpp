@@ -230,8 +230,10 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       return;
     case VP_MSG_TIME_SYNC:
       if (m.u.time_sync.phase == 1 && m.u.time_sync.exchange == sync_exchange_ &&
-          m.u.time_sync.host_tx_us == sync_tx_us_)
+          m.u.time_sync.host_tx_us == sync_tx_us_) {
         clock_.on_sync(m.u.time_sync.host_tx_us, m.u.time_sync.device_rx_us, m.u.time_sync.device_tx_us, now_us);
+        if (on_time_sync_) on_time_sync_(m.u.time_sync.host_tx_us, m.u.time_sync.device_rx_us, m.u.time_sync.device_tx_us, now_us);
+      }
       return;
     case VP_MSG_STATUS:
       if (m.u.status.severity >= 2) last_error_ = "device reports error code " + std::to_string(m.u.status.code);

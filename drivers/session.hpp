@@ -159,6 +159,11 @@ class DeviceSession {
   // Valid messages that are not samples (status, calibration results, heartbeats), for the rig's
   // calibration and diagnostics code.
   void set_on_message(MessageFn f) { on_message_ = std::move(f); }
+  // Every completed time-sync exchange, as its four NTP timestamps (host send, device receive,
+  // device send, host receive): the clock calibration fits offset and drift through them.
+  using TimeSyncFn = std::function<void(std::uint64_t host_tx_us, std::uint64_t device_rx_us, std::uint64_t device_tx_us,
+                                        std::uint64_t host_rx_us)>;
+  void set_on_time_sync(TimeSyncFn f) { on_time_sync_ = std::move(f); }
   // Asks the device to run a calibration procedure; the CALIB_RESULT echoes `token`.
   // False when the link is not up (connecting/configuring/streaming/stale).
   bool request_calibration(std::uint8_t procedure, std::uint8_t instrument_id, std::uint16_t token);
@@ -197,6 +202,7 @@ class DeviceSession {
   SampleFn on_sample_;
   StateFn on_state_;
   MessageFn on_message_;
+  TimeSyncFn on_time_sync_;
   LinkState state_ = LinkState::lost;
   LinkStats stats_;
   vp_device_info info_{};

@@ -39,7 +39,23 @@ std::array<float, 4> quat_from_euler_deg(double yaw, double pitch, double roll) 
   return {float(cr * cp * cy + sr * sp * sy), float(sr * cp * cy - cr * sp * sy), float(cr * sp * cy + sr * cp * sy),
           float(cr * cp * sy - sr * sp * cy)};
 }
+// Hamilton product and rotation of a vector by a unit quaternion (w, x, y, z), in double.
+std::array<double, 4> multiply(const std::array<double, 4>& a, const std::array<double, 4>& b) {
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3], a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+}
+std::array<double, 3> rotate(const std::array<double, 4>& q, const std::array<double, 3>& v) {
+  const std::array<double, 4> p = {0, v[0], v[1], v[2]};
+  const std::array<double, 4> r = multiply(multiply(q, p), {q[0], -q[1], -q[2], -q[3]});
+  return {r[1], r[2], r[3]};
+}
 }  // namespace
+
+bool Imperfections::tracker_any() const {
+  for (int i = 0; i < 3; ++i)
+    if (tip_offset_mm[i] != 0 || frame_ypr_deg[i] != 0 || frame_t_mm[i] != 0) return true;
+  return false;
+}
 
 bool parse_script(const std::string& text, Script& out, std::string* error) {
   Script s;
@@ -103,6 +119,32 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
     } else if (word == "seed") {
       if (!exactly(2, "seed N") || !num(1, a) || a < 0 || a > 9.0e15) return fail("seed must be a non-negative number");
       s.seed = static_cast<std::uint64_t>(a);
+    } else if (word == "tip_offset" || word == "tracker_frame") {
+      const bool frame = word == "tracker_frame";
+      if (!exactly(frame ? 7 : 4, frame ? "tracker_frame YAW PITCH ROLL X Y Z" : "tip_offset X Y Z")) return false;
+      double v[6] = {};
+      for (std::size_t i = 1; i < w.size(); ++i)
+        if (!num(i, v[i - 1]) || std::fabs(v[i - 1]) > 1000) return fail(word + " needs finite numbers (degrees, mm; |x| <= 1000)");
+      for (int i = 0; i < 3; ++i) {
+        if (frame) s.imperfect.frame_ypr_deg[i] = v[i], s.imperfect.frame_t_mm[i] = v[i + 3];
+        else s.imperfect.tip_offset_mm[i] = v[i];
+      }
+    } else if (word == "pedal_range") {
+      if (!exactly(4, "pedal_range AXIS LO HI") || !num(1, a) || (a != 0 && a != 1) || !num(2, b)) return fail("pedal_range AXIS(0|1) LO HI");
+      double hi = 0;
+      if (!num(3, hi) || b < 0 || hi > 1 || !(hi > b)) return fail("pedal_range needs 0 <= LO < HI <= 1");
+      s.imperfect.pedal_lo[static_cast<int>(a)] = b, s.imperfect.pedal_hi[static_cast<int>(a)] = hi;
+    } else if (word == "eye_zero") {
+      if (!exactly(3, "eye_zero YAW PITCH") || !num(1, a) || !num(2, b) || std::fabs(a) > 90 || std::fabs(b) > 90)
+        return fail("eye_zero needs a yaw and a pitch in degrees (-90..90)");
+      s.imperfect.eye_zero_deg[0] = a, s.imperfect.eye_zero_deg[1] = b;
+    } else if (word == "clock_offset_ms") {
+      // The device clock must not go below zero: it has been up kBootUs (5 s) when the link starts.
+      if (!exactly(2, "clock_offset_ms X") || !num(1, a) || a < -4000 || a > 1e9) return fail("clock_offset_ms must be -4000..1e9");
+      s.imperfect.clock_offset_ms = a;
+    } else if (word == "clock_drift_ppm") {
+      if (!exactly(2, "clock_drift_ppm Y") || !num(1, a) || std::fabs(a) > 10000) return fail("clock_drift_ppm must be -10000..10000");
+      s.imperfect.clock_drift_ppm = a;
     } else if (word == "key") {
       const std::size_t width = key_width(s.kind);
       if (w.size() != width + 2)
@@ -186,7 +228,12 @@ void FirmwareEmulator::reset_link() {
 }
 
 std::uint64_t FirmwareEmulator::device_time_us(std::uint64_t now_us) const {
-  std::uint64_t t = (started_ ? now_us - start_us_ : 0) + kBootUs;
+  const std::uint64_t elapsed = started_ ? now_us - start_us_ : 0;
+  std::uint64_t t = elapsed + kBootUs;
+  if (s_.imperfect.clock_any()) {  // only then, so an ideal clock's arithmetic stays integer and exact
+    t = static_cast<std::uint64_t>(static_cast<double>(elapsed) * (1.0 + s_.imperfect.clock_drift_ppm * 1e-6) +
+                                   static_cast<double>(kBootUs) + s_.imperfect.clock_offset_ms * 1000.0);
+  }
   for (auto& f : s_.faults)
     if (f.kind == FaultKind::jump && t >= f.at_us + kBootUs) t = static_cast<std::uint64_t>(static_cast<double>(t) + f.value * 1000);
   return t;
@@ -286,6 +333,20 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       for (int i = 0; i < 3; ++i) p.tip_mm[i] = static_cast<float>(v[static_cast<std::size_t>(i)] + (s_.noise > 0 ? tip(noise_rng_) : 0.0));
       const double jy = s_.noise > 0 ? angle(noise_rng_) : 0.0, jp = s_.noise > 0 ? angle(noise_rng_) : 0.0, jr = s_.noise > 0 ? angle(noise_rng_) : 0.0;
       auto q = quat_from_euler_deg(v[3] + jy, v[4] + jp, v[5] + jr);
+      if (s_.imperfect.tracker_any()) {
+        // The real tip (the keys) → the tracked point behind it → the tracker's own frame.
+        const Imperfections& im = s_.imperfect;
+        const std::array<double, 4> qd = {q[0], q[1], q[2], q[3]};
+        const std::array<float, 4> ff = quat_from_euler_deg(im.frame_ypr_deg[0], im.frame_ypr_deg[1], im.frame_ypr_deg[2]);
+        const std::array<double, 4> f = {ff[0], ff[1], ff[2], ff[3]};
+        double marker[3];
+        const std::array<double, 3> off = rotate(qd, {im.tip_offset_mm[0], im.tip_offset_mm[1], im.tip_offset_mm[2]});
+        for (int i = 0; i < 3; ++i) marker[i] = static_cast<double>(p.tip_mm[i]) - off[static_cast<std::size_t>(i)];
+        const std::array<double, 3> r = rotate(f, {marker[0], marker[1], marker[2]});
+        for (int i = 0; i < 3; ++i) p.tip_mm[i] = static_cast<float>(r[static_cast<std::size_t>(i)] + im.frame_t_mm[i]);
+        const std::array<double, 4> fq = multiply(f, qd);
+        for (int i = 0; i < 4; ++i) q[static_cast<std::size_t>(i)] = static_cast<float>(fq[static_cast<std::size_t>(i)]);
+      }
       for (int i = 0; i < 4; ++i) p.q_wxyz[i] = q[static_cast<std::size_t>(i)];
       p.actuation = static_cast<std::uint16_t>(std::clamp(v[6], 0.0, 1.0) * 65535.0 + 0.5);
       p.quality_pct = 98;
@@ -297,8 +358,13 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       p.timestamp_us = device_us;
       p.pedal_id = 0;
       p.axis_count = 2;
-      p.axes[0] = static_cast<std::uint16_t>(std::clamp(v[0], 0.0, 1.0) * 65535.0 + 0.5);
-      p.axes[1] = static_cast<std::uint16_t>(std::clamp(v[1], 0.0, 1.0) * 65535.0 + 0.5);
+      // The keys are the pedal's travel; its potentiometer maps that onto lo..hi (0..1 when ideal).
+      const Imperfections& im = s_.imperfect;
+      for (int a = 0; a < 2; ++a) {
+        const double travel = std::clamp(v[static_cast<std::size_t>(a)], 0.0, 1.0);
+        const double raw = im.pedal_lo[a] == 0 && im.pedal_hi[a] == 1 ? travel : im.pedal_lo[a] + (im.pedal_hi[a] - im.pedal_lo[a]) * travel;
+        p.axes[a] = static_cast<std::uint16_t>(raw * 65535.0 + 0.5);
+      }
       p.switches = static_cast<std::uint16_t>(v[2]);
       break;
     }
@@ -309,6 +375,11 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       std::normal_distribution<double> angle(0.0, 0.01 * s_.noise), depth(0.0, 0.002 * s_.noise);
       const double jy = s_.noise > 0 ? angle(noise_rng_) : 0.0, jp = s_.noise > 0 ? angle(noise_rng_) : 0.0, jr = s_.noise > 0 ? angle(noise_rng_) : 0.0;
       auto q = quat_from_euler_deg(v[0] + jy, v[1] + jp, jr);
+      if (s_.imperfect.eye_zero_deg[0] != 0 || s_.imperfect.eye_zero_deg[1] != 0) {
+        const std::array<float, 4> zf = quat_from_euler_deg(s_.imperfect.eye_zero_deg[0], s_.imperfect.eye_zero_deg[1], 0.0);
+        const std::array<double, 4> zq = multiply({zf[0], zf[1], zf[2], zf[3]}, {q[0], q[1], q[2], q[3]});
+        for (int i = 0; i < 4; ++i) q[static_cast<std::size_t>(i)] = static_cast<float>(zq[static_cast<std::size_t>(i)]);
+      }
       for (int i = 0; i < 4; ++i) p.q_wxyz[i] = q[static_cast<std::size_t>(i)];
       p.port_count = 3;
       for (int i = 0; i < 3; ++i) {

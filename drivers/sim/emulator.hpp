@@ -38,6 +38,26 @@ struct FaultEvent {
 //                                     never report the same bits twice, and the driver calls a pose
 //                                     that does for 50 ms stuck
 //   fault <t_ms> <duration_ms> nan|range|stuck|jump|version|unknown|drop|disconnect [value]
+// Imperfections to calibrate against (all off by default; rig/calibration/README.md):
+//   tip_offset X Y Z                  tracker: the tracked point sits this far (mm, instrument frame)
+//                                     behind the real tip, which is what the keys describe
+//   tracker_frame YAW PITCH ROLL X Y Z  tracker: the tracker's frame relative to the fixture's (the
+//                                     keys' frame): reported = R·true + t (degrees, mm)
+//   pedal_range AXIS LO HI            pedals: the potentiometer reads LO at rest and HI fully down
+//   clock_offset_ms X  clock_drift_ppm Y   the device clock's extra offset and rate error
+//   eye_zero YAW PITCH                eyeball: what the fixture reads with the eye at rest (degrees):
+//                                     reported = zero · true
+// ("noise 10" gives the 0.05 mm of tracker noise.)
+struct Imperfections {
+  double tip_offset_mm[3] = {0, 0, 0};
+  double frame_ypr_deg[3] = {0, 0, 0};
+  double frame_t_mm[3] = {0, 0, 0};
+  double pedal_lo[2] = {0, 0}, pedal_hi[2] = {1, 1};
+  double clock_offset_ms = 0, clock_drift_ppm = 0;
+  double eye_zero_deg[2] = {0, 0};
+  bool tracker_any() const;
+  bool clock_any() const { return clock_offset_ms != 0 || clock_drift_ppm != 0; }
+};
 struct Script {
   DeviceKind kind = DeviceKind::tracker;
   std::uint16_t rate_hz = 1000;
@@ -55,6 +75,7 @@ struct Script {
   // optical tracker's jitter), eyeball fixture orientation 0.01° and port depth 2 µm. Pedals have a
   // dead band at rest and none.
   double noise = 1.0;
+  Imperfections imperfect;
 };
 // Parses a script; on error returns false with "line N: reason".
 bool parse_script(const std::string& text, Script& out, std::string* error);

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -27,6 +28,7 @@
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/report/trainee_history.hpp"
 #include "rig/report/write_report.hpp"
+#include "rig/session/calibration_in_force.hpp"
 #include "rig/session/rig_session.hpp"
 #include "rig/session/scripted_session.hpp"
 
@@ -113,6 +115,9 @@ int main(int argc, char** argv) {
   std::string replay_path;
   std::string pedal_config;
   std::string rig_path;
+  std::string calibration_path;
+  double calibration_max_age_days = -1.0;  // unset: the rig file's, else 30
+  std::string calibration_in_force = "none (uncalibrated input mapping)";  // for the summary
   std::string script_path;
   bool idle = false;
   std::vector<std::string> serial_devices;
@@ -155,6 +160,12 @@ int main(int argc, char** argv) {
   app.add_option("--sim-unplug", sim_unplugs,
                  "simulated devices: pull NAME's cable AT seconds into the session (physics time) and plug it back FOR\n"
                  "seconds later: NAME:AT:FOR, e.g. tracker-0:1.5:0.5 (repeatable)");
+  app.add_option("--calibration", calibration_path,
+                 "the sensor calibration to apply (vitreo-calibrate's file; overrides the rig file's [calibration])\n"
+                 "refused when made for other devices' serial numbers")
+      ->check(CLI::ExistingFile);
+  app.add_option("--calibration-max-age-days", calibration_max_age_days, "warn when the calibration is older than this (default 30)")
+      ->check(vitreo::app::finite_range(0.001, 36500.0));
   app.add_option("--pedal-config", pedal_config, "TOML pedal mapping (see rig/config/default-rig.toml; overrides the rig file's)")
       ->check(CLI::ExistingFile);
   auto* replay_opt =
@@ -217,6 +228,8 @@ int main(int argc, char** argv) {
       vitreo::rig::RigFile rig = vitreo::rig::read_rig_file(rig_path);
       devices = std::move(rig.devices);
       if (rig.pedals) model.pedals = *rig.pedals;
+      if (calibration_path.empty()) calibration_path = rig.calibration_path;
+      if (calibration_max_age_days < 0.0 && rig.calibration_max_age_days) calibration_max_age_days = *rig.calibration_max_age_days;
       spdlog::info("rig {}: {} device(s){}", rig_path, devices.size(), rig.name.empty() ? "" : " — " + rig.name);
     }
     if (!pedal_config.empty()) {
@@ -338,6 +351,17 @@ int main(int argc, char** argv) {
       // The embedded default: the three devices simulated behind ptys.
       devices = vitreo::rig::simulated_devices(script);  // a second tracker when the script has a second hand
     }
+    if (!calibration_path.empty()) {
+      const auto now_s = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+      const auto load = vitreo::rig::load_calibration(
+          calibration_path, devices, model,
+          calibration_max_age_days > 0.0 ? calibration_max_age_days : vitreo::rig::kDefaultCalibrationMaxAgeDays, now_s);
+      for (const auto& n : load.notes) spdlog::info("{}", n);
+      for (const auto& w : load.warnings) spdlog::warn("{}", w);
+      calibration_in_force = calibration_path + " (" + vitreo::rig::calibration_id(load.file) + ")" +
+                             (load.warnings.empty() ? "" : " — " + load.warnings.front());
+      config.model = model;
+    }
     config.devices = devices;
     // Lockstep wherever every device is simulated (a scripted session's outcome must not depend on
     // the machine's load); real devices run on their own clocks.
@@ -395,6 +419,7 @@ int main(int argc, char** argv) {
     std::printf("  instruments      %s\n", s.instruments.c_str());
     std::printf("  script           %s%s%s\n", script.file.empty() ? "none (idle)" : script.file.c_str(),
                 script.file.empty() ? "" : (" (" + script.kind + ")").c_str(), script.summary.empty() ? "" : (": " + script.summary).c_str());
+    std::printf("  calibration      %s\n", calibration_in_force.c_str());
     for (const auto& line : s.cases_loaded) std::printf("  case loaded      %s\n", line.c_str());
     std::printf("  simulated        %.3f s in %llu steps (%s)\n", s.simulated_s, static_cast<unsigned long long>(s.steps),
                 s.stop_reason == "duration reached" ? "the whole duration" : ("stopped early by " + s.stop_reason).c_str());

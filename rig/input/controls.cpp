@@ -16,11 +16,22 @@ namespace {
 bool bit(std::uint16_t switches, int index) { return index >= 0 && index < 16 && ((switches >> index) & 1u) != 0; }
 }  // namespace
 
-bool PedalMapper::apply(const PedalReading& r) {
-  if (r.axis_count < 0 || r.axis_count > 4) return false;
-  for (int i = 0; i < r.axis_count; ++i) {
-    if (!std::isfinite(r.axes[i]) || r.axes[i] < 0.0 || r.axes[i] > 1.0) return false;
+double AxisRange::apply(double raw) const {
+  const double span = hi - lo;
+  if (!(span > 0.0) || !std::isfinite(raw)) return 0.0;
+  const double n = std::clamp((raw - lo) / span, 0.0, 1.0);
+  if (n <= dead_zone) return 0.0;
+  return dead_zone < 1.0 ? (n - dead_zone) / (1.0 - dead_zone) : 0.0;
+}
+
+bool PedalMapper::apply(const PedalReading& raw) {
+  if (raw.axis_count < 0 || raw.axis_count > 4) return false;
+  for (int i = 0; i < raw.axis_count; ++i) {
+    if (!std::isfinite(raw.axes[i]) || raw.axes[i] < 0.0 || raw.axes[i] > 1.0) return false;
   }
+  PedalReading r = raw;
+  for (const AxisRange& a : m_.axis_ranges)
+    if (a.pedal_id == r.pedal_id && a.axis >= 0 && a.axis < r.axis_count) r.axes[a.axis] = a.apply(r.axes[a.axis]);
   auto axis = [&](int index) { return index >= 0 && index < r.axis_count ? r.axes[index] : 0.0; };
   if (r.pedal_id == m_.vitrectomy_pedal_id) {
     c_.vacuum_mmhg = axis(m_.vacuum_axis) * m_.vacuum_max_mmhg;

@@ -7,10 +7,24 @@
 // (rig/config/default-rig.toml).
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace vitreo::rig {
 
+// A pedal axis's calibrated travel (rig/calibration/pedal_range.hpp measures it): its potentiometer
+// reads `lo` at rest and `hi` fully down, and jitters at rest within `dead_zone` of the travel.
+struct AxisRange {
+  int pedal_id = 0;
+  int axis = 0;
+  double lo = 0.0, hi = 1.0, dead_zone = 0.0;
+  // The raw reading mapped onto 0..1 with the dead zone removed:
+  // n = clamp((raw - lo) / (hi - lo), 0, 1); n <= dead_zone ? 0 : (n - dead_zone) / (1 - dead_zone).
+  double apply(double raw) const;
+};
+
 struct PedalMapping {
+  // Calibrated axes (from a calibration file); an axis not listed reads its raw 0..1 travel.
+  std::vector<AxisRange> axis_ranges;
   int vitrectomy_pedal_id = 0;
   int vacuum_axis = 0;
   double vacuum_max_mmhg = 650.0;

@@ -22,7 +22,12 @@ bool map_through_port(const TrackedPose& tracked, const Port& port, const core::
   }
   // Rig frame → eye frame at rest → eye frame as the fixture has turned it.
   const core::Quat to_eye = eye_rotation.conjugate() * calibration.rig_to_eye;
-  const core::Vec3 tip = to_eye * (tracked.tip_mm - calibration.eye_center_in_rig_mm);
+  // Only with an offset: adding a zero vector turns a -0.0 into +0.0, and uncalibrated sessions must
+  // keep their bits (golden state hashes).
+  const core::Vec3 tip_in_rig = calibration.tip_offset_mm == core::Vec3::Zero()
+                                    ? tracked.tip_mm
+                                    : core::Vec3(tracked.tip_mm + tracked.orientation * calibration.tip_offset_mm);
+  const core::Vec3 tip = to_eye * (tip_in_rig - calibration.eye_center_in_rig_mm);
   const core::Quat orientation = to_eye * tracked.orientation;
 
   InstrumentPose pose;

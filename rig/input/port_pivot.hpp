@@ -17,9 +17,14 @@ struct Port {
 };
 
 // Where the eye sits in the rig when the fixture reads zero rotation: rig frame → eye frame.
+// vitreo-calibrate measures both (rig/calibration/): the registration gives rig_to_eye and the eye's
+// centre, the instrument's pivot calibration its tip offset.
 struct TrackerCalibration {
   core::Quat rig_to_eye = core::Quat::Identity();
   core::Vec3 eye_center_in_rig_mm = core::Vec3::Zero();
+  // From the point the tracker reports to the real tip, in the instrument's frame (the tracked
+  // marker sits up the shaft): tip = reported + orientation · tip_offset_mm.
+  core::Vec3 tip_offset_mm = core::Vec3::Zero();
 };
 
 struct InstrumentPose {

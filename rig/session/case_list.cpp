@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "rig/session/calibration_in_force.hpp"
 #include "rig/session/simulation_model.hpp"
 
 namespace vitreo::rig {
@@ -25,6 +26,8 @@ std::string encode_case_list(const ModelConfig& c) {
     out += t.text;
     out += t.library_text;
   }
+  // The calibration in force, only when there is one (recordings without it are unchanged).
+  if (!c.calibration_text.empty()) out += "calibration " + std::to_string(c.calibration_text.size()) + "\n" + c.calibration_text;
   return out;
 }
 
@@ -65,6 +68,12 @@ void decode_case_list(const std::string& text, ModelConfig& config) {
   if (line() != "vitreo-cases 1") fail("not a vitreo case list (or a newer version)");
   ModelConfig out = config;
   out.cases.clear();
+  // The recording alone says which calibration mapped its inputs: none unless it carries one.
+  out.calibration = {};
+  out.measured_ports = {};
+  out.calibration_text.clear();
+  out.eye_zero = core::Quat::Identity();
+  out.pedals.axis_ranges.clear();
   long long first_case = 0;
   constexpr long long kMaxCases = 4096;
   while (at < text.size()) {
@@ -85,6 +94,16 @@ void decode_case_list(const std::string& text, ModelConfig& config) {
       t.library_text = text.substr(at + static_cast<std::size_t>(a + b), static_cast<std::size_t>(c));
       at += static_cast<std::size_t>(a + b + c);
       out.cases.push_back(std::move(t));
+    } else if (w.size() == 2 && w[0] == "calibration") {
+      const auto left = static_cast<long long>(text.size() - at);
+      if (!parse_count(w[1], 1, left, a)) fail("bad calibration line '" + shown + "'");
+      const std::string cal = text.substr(at, static_cast<std::size_t>(a));
+      at += static_cast<std::size_t>(a);
+      try {
+        apply_calibration(cal, "recording's calibration", out);
+      } catch (const std::exception& e) {
+        fail(e.what());
+      }
     } else if (w.size() == 2 && w[0] == "first_case") {
       if (!parse_count(w[1], 0, kMaxCases - 1, first_case)) fail("first_case out of range in '" + shown + "'");
     } else if (w.size() == 2 && w[0] == "retina_vertices") {

@@ -219,7 +219,10 @@ void DeviceHub::lockstep_connect(double wall_timeout_s) {
     ++lock_stats_.handshake_rounds;
     std::string missing;
     for (const auto& d : devices_) {
-      if (d->driver->session().state() != drivers::LinkState::streaming) missing += (missing.empty() ? "" : ", ") + d->spec.name;
+      if (d->driver->session().state() == drivers::LinkState::streaming) continue;
+      // Say why where the driver knows (the wrong unit: "device is type 1 serial 1002, expected …").
+      const std::string& why = d->driver->session().last_error();
+      missing += (missing.empty() ? "" : ", ") + d->spec.name + (why.empty() ? "" : " (" + why + ")");
     }
     if (missing.empty()) return;
     if (std::chrono::steady_clock::now() > deadline)

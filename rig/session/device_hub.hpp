@@ -90,6 +90,17 @@ class DeviceHub {
   static constexpr std::uint64_t kStallWallUs = 200'000;
 
   std::size_t device_count() const { return devices_.size(); }
+  // Before start(): called on the driver thread for each completed time-sync exchange of `device`
+  // (vitreo-calibrate's clock calibration).
+  void on_time_sync(std::size_t device, drivers::DeviceSession::TimeSyncFn f) {
+    devices_[device]->driver->session().set_on_time_sync(std::move(f));
+  }
+  // The serial number the device announced (0 before it identified); read it while the driver
+  // thread is quiet (lockstep, between grants) or after stop().
+  std::uint32_t announced_serial(std::size_t device) const {
+    const auto& s = devices_[device]->driver->session();
+    return s.has_device_info() ? s.device_info().serial : 0;
+  }
   // Cable pull / re-plug of a simulated device (tests, demonstrations); no effect on a real one.
   // Thread-safe.
   void unplug(std::size_t device);

@@ -47,7 +47,8 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
     throw std::runtime_error(origin + ":" + std::to_string(line_of(n)) + ": " + key + ": " + why);
   };
   for (const auto& [k, v] : root) {
-    if (k != "rig" && k != "device" && k != "pedals") fail(v, std::string(k.str()), "unknown key (rig, device, pedals)");
+    if (k != "rig" && k != "device" && k != "pedals" && k != "calibration")
+      fail(v, std::string(k.str()), "unknown key (rig, device, pedals, calibration)");
   }
   RigFile out;
   const toml::table* rig = root["rig"].as_table();
@@ -169,6 +170,25 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
     out.devices.push_back(std::move(spec));
   }
   if (root["pedals"]) out.pedals = parse_pedal_mapping(text, origin);
+  if (const toml::node* c = root.get("calibration")) {
+    if (!c->is_table()) fail(*c, "calibration", "must be a table (file, max_age_days)");
+    for (const auto& [k, v] : *c->as_table()) {
+      const std::string key = "calibration." + std::string(k.str());
+      if (k == "file") {
+        if (!v.is_string() || v.value<std::string>()->empty()) fail(v, key, "must be a non-empty string");
+        const std::filesystem::path p(*v.value<std::string>());
+        out.calibration_path = (p.is_absolute() ? p : std::filesystem::path(base_dir) / p).string();
+      } else if (k == "max_age_days") {
+        const std::optional<double> d = v.is_integer() ? std::optional<double>(static_cast<double>(*v.value<std::int64_t>()))
+                                                       : v.is_floating_point() ? v.value<double>() : std::nullopt;
+        if (!d || !(*d > 0.0) || *d > 36500.0) fail(v, key, "must be a number of days in (0, 36500]");
+        out.calibration_max_age_days = *d;
+      } else {
+        fail(v, key, "unknown key (file, max_age_days)");
+      }
+    }
+    if (out.calibration_path.empty()) fail(*c, "calibration.file", "missing");
+  }
   return out;
 }
 

@@ -20,6 +20,10 @@
 //
 //   [pedals]                         # optional: the pedal mapping (rig/input/controls.hpp)
 //
+//   [calibration]                    # optional: the sensor calibration in force (vitreo-calibrate)
+//   file = "bench2.calibration.toml" # relative to the rig file; `vitreo --calibration` overrides it
+//   max_age_days = 30                # optional: warn when the calibration is older (default 30)
+//
 // Errors name the file, line and key ("rig/config/x.toml:12: device[1].uri: ..."), like the
 // scene files' (rig/scene_io).
 #include <cstdint>
@@ -53,7 +57,11 @@ struct RigFile {
   std::string name;
   std::vector<DeviceSpec> devices;
   std::optional<PedalMapping> pedals;
+  std::string calibration_path;              // empty: none (resolved against the rig file's folder)
+  std::optional<double> calibration_max_age_days;
 };
+
+inline constexpr double kDefaultCalibrationMaxAgeDays = 30.0;
 
 // Throws std::runtime_error "<origin>:<line>: <key>: <reason>". Scripts named in the file are read
 // relative to base_dir.

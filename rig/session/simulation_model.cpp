@@ -100,7 +100,9 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       if (!slot.frozen) {
         InstrumentPose pose;
         // In the fixture frame: the instrument system applies the eye's rotation itself.
-        ok = map_through_port(t.pose, case_->tracker_ports[t.instrument_id], core::Quat::Identity(), config_.calibration, pose);
+        const std::size_t i = static_cast<std::size_t>(t.instrument_id);
+        const Port& port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[t.instrument_id];
+        ok = map_through_port(t.pose, port, core::Quat::Identity(), config_.calibration[i], pose);
         if (ok) {
           slot.present = true;
           slot.port = case_->tracker_port_ids[t.instrument_id];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
@@ -121,7 +123,11 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
   } else if (DecodedEyeball e; decode_eyeball(in, e)) {
     const double n = e.orientation.coeffs().norm();
     if (std::abs(n - 1.0) < 1e-3) {
-      eye_rotation_ = e.orientation.normalized();
+      // Relative to the calibrated rest reading; skipped when there is none, so uncalibrated
+      // sessions keep their bits.
+      eye_rotation_ = config_.eye_zero.coeffs() == core::Quat::Identity().coeffs()
+                          ? e.orientation.normalized()
+                          : (config_.eye_zero.conjugate() * e.orientation.normalized()).normalized();
       eye_tracked_ = true;
       ok = true;
     }

@@ -48,7 +48,13 @@ struct ModelConfig {
   scene_io::CaseLoadOptions load;  // cache folder, resolution overrides
   double dt_s = 1e-3;
   PedalMapping pedals;
-  TrackerCalibration calibration;
+  // The rig's sensor calibration (rig/session/calibration_in_force.hpp): per tracked instrument its
+  // tracker calibration and, when measured on the fixture, its port. calibration_text is the file in
+  // force (empty: none), carried by the recording so a replay maps the inputs the same way.
+  std::array<TrackerCalibration, kTrackedInstruments> calibration{};
+  std::array<std::optional<Port>, kTrackedInstruments> measured_ports{};
+  core::Quat eye_zero = core::Quat::Identity();  // the fixture's reading with the eye at rest
+  std::string calibration_text;
   core::MicroscopeSettings microscope;
 };
 

@@ -1,0 +1,324 @@
+#include "rig/calibration/procedure.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace vitreo::rig::calibration {
+
+Fixture default_fixture() {
+  Fixture f;
+  const double r = 12.0;
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * std::numbers::pi / 3.0;
+    f.fiducials_mm.emplace_back(0.8 * r * std::cos(a), 0.8 * r * std::sin(a), 0.6 * r);
+  }
+  f.fiducials_mm.emplace_back(0.0, 0.0, r);
+  f.fiducials_mm.emplace_back(r + 1.0, 0.0, 0.0);
+  // Pars plana: 3.5 mm behind a 5.75 mm-radius limbus on the 12 mm globe, at 10 and 2 o'clock.
+  const double z = 4.6, rho = std::sqrt(r * r - z * z);
+  f.ports_mm.emplace_back(-rho * std::cos(std::numbers::pi / 6), rho * std::sin(std::numbers::pi / 6), z);
+  f.ports_mm.emplace_back(rho * std::cos(std::numbers::pi / 6), rho * std::sin(std::numbers::pi / 6), z);
+  return f;
+}
+
+namespace {
+
+constexpr double kMove = 0.5, kHold = 0.7, kSettle = 0.15;  // s: a touch's move, hold, and the margin cut off each end
+const core::Vec3 kRest(30.0, 0.0, 25.0);                   // the instrument's parking place, well clear of the eye
+
+// fixed(v, n): v with n decimals (the feedback's numbers).
+std::string fixed(double v, int digits) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f", digits, v);
+  return b;
+}
+
+// An emulator tracker key: time, tip (eye frame), yaw/pitch/roll in degrees, actuation 0.
+void tracker_key(std::string& out, double t_s, const core::Vec3& p, double yaw, double pitch, double roll) {
+  char b[160];
+  std::snprintf(b, sizeof b, "key %.1f %.4f %.4f %.4f %.3f %.3f %.3f 0\n", t_s * 1000.0, p.x(), p.y(), p.z(), yaw, pitch, roll);
+  out += b;
+}
+
+}  // namespace
+
+Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
+                         const std::string& eyeball) {
+  Procedure proc;
+  double end = 0.0;
+  // Pivoting: a widening spiral of the shaft about the tip in the divot (two directions, so the
+  // offset along the shaft is observable), 6 s at 20 keys per second.
+  const double pivot_start = 0.5, pivot_end = 6.5;
+  for (const TrackerRole& t : trackers) {
+    std::string& m = proc.motion[t.device];
+    tracker_key(m, 0.0, kRest, 0, 0, 0);
+    tracker_key(m, pivot_start - 0.2, fixture.divot_mm, 0, 0, 0);
+    for (double s = pivot_start; s <= pivot_end + 1e-9; s += 0.05) {
+      const double u = (s - pivot_start) / (pivot_end - pivot_start);
+      const double amplitude = 10.0 + 18.0 * u, phase = 2.0 * std::numbers::pi * (s - pivot_start) / 1.5;
+      tracker_key(m, s, fixture.divot_mm, 15.0 * std::sin(0.7 * s), amplitude * std::sin(phase), amplitude * std::cos(phase));
+    }
+    proc.steps.push_back({StepKind::pivot, t.device, t.instrument, pivot_start + 0.1, pivot_end - 0.1,
+                          "rest the tip of instrument " + std::to_string(t.instrument) +
+                              " in the divot and swing the handle round it in widening circles"});
+  }
+  end = pivot_end;
+  if (!trackers.empty()) {
+    const TrackerRole& first = trackers.front();
+    std::string& m = proc.motion[first.device];
+    double t = pivot_end;
+    auto touch = [&](StepKind kind, int index, const core::Vec3& where, const std::string& what) {
+      tracker_key(m, t + kMove, where, 0.0, 25.0, 0.0);
+      tracker_key(m, t + kMove + kHold, where, 0.0, 25.0, 0.0);
+      proc.steps.push_back({kind, first.device, index, t + kMove + kSettle, t + kMove + kHold - kSettle, what});
+      t += kMove + kHold;
+    };
+    for (std::size_t i = 0; i < fixture.fiducials_mm.size(); ++i)
+      touch(StepKind::fiducial, static_cast<int>(i), fixture.fiducials_mm[i],
+            "touch fiducial " + std::to_string(i + 1) + " of " + std::to_string(fixture.fiducials_mm.size()) + " and hold still");
+    for (std::size_t i = 0; i < fixture.ports_mm.size(); ++i)
+      touch(StepKind::port, static_cast<int>(i), fixture.ports_mm[i],
+            "hold the tip in port " + std::to_string(i) + "'s trocar");
+    tracker_key(m, t + kMove, kRest, 0, 0, 0);
+    end = std::max(end, t + kMove);
+  }
+  if (!pedals.empty()) {
+    // Rest, then each axis fully down, held, and up again.
+    std::string& m = proc.motion[pedals];
+    m += "key 0 0 0 0\nkey 1500 0 0 0\n";
+    proc.steps.push_back({StepKind::pedal_rest, pedals, 0, 0.3, 1.4, "leave both pedals alone"});
+    for (int axis = 0; axis < 2; ++axis) {
+      const double s = 1.5 + 2.5 * axis;
+      char b[200];
+      std::snprintf(b, sizeof b, "key %.0f %d %d 0\nkey %.0f %d %d 0\nkey %.0f 0 0 0\n", (s + 1.0) * 1000, axis == 0, axis == 1,
+                    (s + 1.5) * 1000, axis == 0, axis == 1, (s + 2.5) * 1000);
+      m += b;
+      proc.steps.push_back({StepKind::pedal_travel, pedals, axis, s, s + 2.5,
+                            std::string(axis == 0 ? "press the pedal" : "tilt the pedal sideways") + " all the way and let it back"});
+    }
+    end = std::max(end, 6.5);
+  }
+  if (!eyeball.empty()) {
+    // The eye is left in its rest position at the start: what the fixture reads then is its zero.
+    proc.motion[eyeball] = "key 0 0 0 0 0 0\n";
+    proc.steps.push_back({StepKind::eye_zero, eyeball, 0, 0.3, 1.4, "leave the eye in its rest position"});
+  }
+  proc.duration_s = end + 0.5;
+  for (const TrackerRole& t : trackers) proc.steps.push_back({StepKind::clock, t.device, 0, 0.0, proc.duration_s, "keep the devices connected"});
+  for (const std::string& d : {pedals, eyeball})
+    if (!d.empty()) proc.steps.push_back({StepKind::clock, d, 0, 0.0, proc.duration_s, "keep the devices connected"});
+  return proc;
+}
+
+namespace {
+
+template <class T>
+std::vector<T> in_window(const std::vector<T>& all, double a, double b) {
+  std::vector<T> out;
+  for (const T& x : all)
+    if (x.t_s >= a && x.t_s <= b) out.push_back(x);
+  return out;
+}
+
+std::string vec_text(const core::Vec3& v) {
+  char b[96];
+  std::snprintf(b, sizeof b, "(%.3f, %.3f, %.3f)", v.x(), v.y(), v.z());
+  return b;
+}
+
+}  // namespace
+
+Analysis analyse(const Procedure& proc, const Fixture& fixture, const Recording& rec, const Limits& limits) {
+  Analysis a;
+  std::map<std::string, core::Vec3> tip_offset;  // by device, once its pivot passed
+  std::vector<core::Vec3> touched;               // fiducials, tracker frame
+  std::vector<std::vector<core::Vec3>> port_tips_rig(fixture.ports_mm.size());
+  std::string port_device;
+  std::map<std::string, std::vector<double>> rest[2];
+  static const std::vector<TimedPose> kNoPoses;
+  static const std::vector<TimedPedal> kNoPedals;
+  auto poses_of = [&](const std::string& d) -> const std::vector<TimedPose>& {
+    const auto it = rec.poses.find(d);
+    return it == rec.poses.end() ? kNoPoses : it->second;
+  };
+  auto pedals_of = [&](const std::string& d) -> const std::vector<TimedPedal>& {
+    const auto it = rec.pedals.find(d);
+    return it == rec.pedals.end() ? kNoPedals : it->second;
+  };
+  auto outcome = [&](const ProcedureStep& s, bool ok, const std::string& feedback) {
+    a.steps.push_back({&s, ok, feedback});
+    if (!ok) a.errors.push_back(s.device + ": " + s.instruction + ": " + feedback);
+  };
+  for (const ProcedureStep& s : proc.steps) {
+    switch (s.kind) {
+      case StepKind::pivot: {
+        std::vector<PivotPose> poses;
+        for (const TimedPose& p : in_window(poses_of(s.device), s.start_s, s.end_s)) poses.push_back({p.position_mm, p.orientation});
+        const PivotResult r = calibrate_pivot(poses, limits.pivot);
+        std::string fb = std::to_string(r.poses) + " samples, spread " + (fixed(r.spread_deg, 1) + "°") + ", RMS " +
+                         (fixed(r.rms_mm, 3) + " mm") + (" (limit " + fixed(limits.pivot.max_rms_mm, 3) + " mm)");
+        if (r.ok) {
+          tip_offset[s.device] = r.tip_offset_mm;
+          a.file.instruments.push_back({s.index, r.tip_offset_mm, r.poses, r.spread_deg, r.rms_mm});
+          fb += ", tip offset " + vec_text(r.tip_offset_mm) + " mm";
+        }
+        outcome(s, r.ok, r.ok ? fb : r.error + " — " + fb);
+        break;
+      }
+      case StepKind::fiducial:
+      case StepKind::port: {
+        const auto t = tip_offset.find(s.device);
+        if (t == tip_offset.end()) {
+          outcome(s, false, "needs this instrument's pivot calibration first");
+          break;
+        }
+        std::vector<core::Vec3> tips;
+        for (const TimedPose& p : in_window(poses_of(s.device), s.start_s, s.end_s))
+          tips.push_back(p.position_mm + p.orientation.normalized() * t->second);
+        if (tips.size() < limits.port.min_samples) {
+          outcome(s, false, "only " + std::to_string(tips.size()) + " samples while holding (need " +
+                                std::to_string(limits.port.min_samples) + "): did the tracker stop?");
+          break;
+        }
+        core::Vec3 mean = core::Vec3::Zero();
+        for (const core::Vec3& p : tips) mean += p;
+        mean /= static_cast<double>(tips.size());
+        double sq = 0.0;
+        for (const core::Vec3& p : tips) sq += (p - mean).squaredNorm();
+        const double spread = std::sqrt(sq / static_cast<double>(tips.size()));
+        const std::string fb = std::to_string(tips.size()) + " samples, held within " + (fixed(spread, 3) + " mm");
+        if (s.kind == StepKind::fiducial) {
+          const bool still = spread <= limits.port.max_spread_mm;
+          if (still) touched.push_back(mean);
+          outcome(s, still, still ? fb : "the tip moved while touching: " + fb);
+        } else {
+          port_tips_rig[static_cast<std::size_t>(s.index)] = tips;
+          port_device = s.device;
+          outcome(s, true, fb);
+        }
+        break;
+      }
+      case StepKind::pedal_rest: {
+        const auto samples = in_window(pedals_of(s.device), s.start_s, s.end_s);
+        for (const TimedPedal& p : samples)
+          for (int ax = 0; ax < 2; ++ax) rest[ax][s.device].push_back(p.axes[ax]);
+        const bool ok = samples.size() >= limits.pedal.min_rest_samples;
+        outcome(s, ok, std::to_string(samples.size()) + " samples at rest" + (ok ? "" : ": did the pedals stop?"));
+        break;
+      }
+      case StepKind::pedal_travel: {
+        const auto samples = in_window(pedals_of(s.device), s.start_s, s.end_s);
+        std::vector<double> travel;
+        for (const TimedPedal& p : samples) travel.push_back(p.axes[s.index]);
+        const PedalRangeResult r = measure_pedal_range(rest[s.index][s.device], travel, limits.pedal);
+        const std::string fb = std::to_string(travel.size()) + " samples, reads " + (fixed(r.range.lo, 3)) + " at rest to " +
+                               (fixed(r.range.hi, 3)) + " fully, dead zone " + (fixed(r.range.dead_zone, 3));
+        if (r.ok) a.file.pedals.push_back({samples.empty() ? 0 : samples.front().pedal_id, s.index, r.range});
+        outcome(s, r.ok, r.ok ? fb : r.error);
+        break;
+      }
+      case StepKind::eye_zero: {
+        const auto it = rec.eyeball.find(s.device);
+        std::vector<TimedOrientation> samples = in_window(it == rec.eyeball.end() ? std::vector<TimedOrientation>{} : it->second,
+                                                          s.start_s, s.end_s);
+        if (samples.size() < limits.eye_zero.min_samples) {
+          outcome(s, false, "only " + std::to_string(samples.size()) + " samples at rest (need " +
+                                std::to_string(limits.eye_zero.min_samples) + "): did the fixture stop?");
+          break;
+        }
+        // The mean of nearby unit quaternions: their sign-aligned sum, normalised (accurate to
+        // second order in the spread, which is checked to be small).
+        Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+        const Eigen::Vector4d first = samples.front().orientation.coeffs();
+        for (const TimedOrientation& o : samples) sum += o.orientation.coeffs().dot(first) < 0 ? -o.orientation.coeffs() : o.orientation.coeffs();
+        core::Quat mean;
+        mean.coeffs() = sum.normalized();
+        double spread = 0.0;
+        for (const TimedOrientation& o : samples) spread = std::max(spread, mean.angularDistance(o.orientation) * 180.0 / std::numbers::pi);
+        const Eigen::AngleAxisd aa(mean);
+        const std::string fb = std::to_string(samples.size()) + " samples, zero " + fixed(aa.angle() * 180.0 / std::numbers::pi, 3) +
+                               "° from the fixture's, still within " + fixed(spread, 3) + "°";
+        const bool still = spread <= limits.eye_zero.max_spread_deg;
+        if (still) a.file.eye_zero = EyeZeroRecord{mean, samples.size(), spread};
+        outcome(s, still, still ? fb : "the eye moved: " + fb);
+        break;
+      }
+      case StepKind::clock: {
+        const auto it = rec.clocks.find(s.device);
+        const ClockResult r = estimate_clock(it == rec.clocks.end() ? std::vector<TimeSyncExchange>{} : it->second, limits.clock);
+        if (r.ok) a.file.clocks.push_back({s.device, r.offset_ms, r.drift_ppm, r.latency_ms, r.rms_ms});
+        outcome(s, r.ok,
+                r.ok ? std::to_string(r.used) + " of " + std::to_string(r.exchanges) + " time syncs: offset " +
+                           (fixed(r.offset_ms, 3) + " ms") + ", drift " + (fixed(r.drift_ppm, 1) + " ppm") + ", latency " +
+                           (fixed(r.latency_ms, 3) + " ms")
+                     : r.error);
+        break;
+      }
+    }
+  }
+  // Registration from the touched fiducials, then the ports through it.
+  if (touched.size() == fixture.fiducials_mm.size()) {
+    const RegistrationResult r = register_points(touched, fixture.fiducials_mm, limits.registration);
+    a.fiducial_residuals_mm = r.residuals_mm;
+    if (r.ok) {
+      RegistrationRecord rr;
+      rr.rig_to_eye = r.rig_to_eye.rotation;
+      rr.eye_center_in_rig_mm = -(r.rig_to_eye.rotation.conjugate() * r.rig_to_eye.translation_mm);
+      rr.fiducials = r.points;
+      rr.fre_mm = r.fre_mm;
+      rr.tre_mm = predicted_tre_mm(fixture.fiducials_mm, fle_from_fre(r.fre_mm, r.points), fixture.tre_target_mm);
+      a.file.registration = rr;
+      for (std::size_t i = 0; i < port_tips_rig.size(); ++i) {
+        if (port_tips_rig[i].empty()) continue;
+        std::vector<core::Vec3> in_eye;
+        for (const core::Vec3& p : port_tips_rig[i]) in_eye.push_back(r.rig_to_eye.apply(p));
+        const PortResult pr = measure_port(in_eye, limits.port);
+        if (pr.ok) a.file.ports.push_back({static_cast<int>(i), pr.position_mm, pr.outward, pr.samples, pr.spread_mm});
+        else a.errors.push_back(port_device + ": port " + std::to_string(i) + ": " + pr.error);
+      }
+    } else {
+      a.errors.push_back("registration: " + r.error);
+    }
+  } else if (!fixture.fiducials_mm.empty() && !touched.empty()) {
+    a.errors.push_back("registration: " + std::to_string(touched.size()) + " of " + std::to_string(fixture.fiducials_mm.size()) +
+                       " fiducials were touched; registration needs them all");
+  }
+  for (const auto& [name, serial] : rec.serials) a.file.devices.push_back({name, serial});
+  a.ok = a.errors.empty();
+  return a;
+}
+
+std::string summary_text(const Analysis& a) {
+  std::string s = "calibration summary\n";
+  const CalibrationFile& f = a.file;
+  for (const DeviceSerial& d : f.devices) s += "  device " + d.name + ": serial " + std::to_string(d.serial) + "\n";
+  for (const InstrumentRecord& i : f.instruments)
+    s += "  instrument " + std::to_string(i.instrument) + " tip offset " + vec_text(i.tip_offset_mm) + " mm: pivot RMS " +
+         (fixed(i.rms_mm, 3) + " mm") + " over " + std::to_string(i.poses) + " poses, spread " + (fixed(i.spread_deg, 1) + "°") + "\n";
+  if (f.registration) {
+    const RegistrationRecord& r = *f.registration;
+    s += "  registration: " + std::to_string(r.fiducials) + " fiducials, FRE " + (fixed(r.fre_mm, 3) + " mm") + ", TRE " +
+         (fixed(r.tre_mm, 3) + " mm") + (r.tre_measured ? " (measured)" : " (predicted at the posterior pole)") + "\n";
+    s += "    residual per fiducial (mm):";
+    for (double e : a.fiducial_residuals_mm) s += (" " + fixed(e, 3));
+    s += "\n";
+  }
+  for (const PortRecord& p : f.ports)
+    s += "  port " + std::to_string(p.port) + " at " + vec_text(p.position_mm) + " mm (eye frame), held within " +
+         (fixed(p.spread_mm, 3) + " mm") + "\n";
+  for (const PedalRecord& p : f.pedals)
+    s += "  pedal " + std::to_string(p.pedal) + " axis " + std::to_string(p.axis) + ": " + (fixed(p.range.lo, 3)) + " .. " +
+         (fixed(p.range.hi, 3)) + ", dead zone " + (fixed(p.range.dead_zone, 3)) + "\n";
+  if (f.eye_zero)
+    s += "  eyeball zero: " + fixed(Eigen::AngleAxisd(f.eye_zero->zero).angle() * 180.0 / std::numbers::pi, 3) +
+         "° from the fixture's own, still within " + fixed(f.eye_zero->spread_deg, 3) + "°\n";
+  for (const ClockRecord& c : f.clocks)
+    s += "  clock " + c.device + ": offset " + (fixed(c.offset_ms, 3) + " ms") + ", drift " + (fixed(c.drift_ppm, 1) + " ppm") +
+         ", latency " + (fixed(c.latency_ms, 3) + " ms") + "\n";
+  s += a.ok ? "  result: PASS\n" : "  result: FAIL\n";
+  for (const std::string& e : a.errors) s += "    " + e + "\n";
+  return s;
+}
+
+}  // namespace vitreo::rig::calibration
