@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <numeric>
 
@@ -815,22 +816,39 @@ TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
   }
 }
 
+// A vitrector at full vacuum over an anchored 4 mm gel sheet: its shaft along +x just above the sheet,
+// the port turned down toward it. Full suction removes a fifth of the sheet in 300 ms; the
+// guillotine's cuts around the port take more spring and triangle slots on the way than the default
+// reserve.
+struct VitrectorOverSheet {
+  TissueWorld world{GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()};
+  std::uint32_t gel = 0;
+  std::unique_ptr<TopologyAdapter> topology;
+  InstrumentSceneOptions options;
+  std::unique_ptr<Simulation> sys;
+  InstrumentInput input;
+  VitrectorOverSheet() {
+    SurfaceDescription dd = sheet(4.0, 40, 0.0);
+    dd.capacity.minimum_extra = 8192;
+    gel = world.add_surface(dd);
+    anchor_border(world.surface(gel), 4.0);
+    topology = std::make_unique<TopologyAdapter>(world, std::vector<std::uint32_t>{}, std::vector<std::uint32_t>{gel});
+    options.ports_mm = {Vec3(-10, 0, 0.6)};
+    sys = std::make_unique<Simulation>(world, options, std::vector<InstrumentDescription>{{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
+    sys->set_topology(topology.get());
+    input = InstrumentInput::through_port(options.ports_mm[0], Vec3::UnitX(), 10.0, std::numbers::pi);
+    input.pedal = 1.0;
+  }
+};
+
 TEST(Instruments, VitrectorRemovesOnlyAtItsPort) {
-  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
-  // 300 ms of full suction remove a fifth of the sheet; the guillotine's cuts around the port take
-  // more spring and triangle slots on the way than the default reserve.
-  SurfaceDescription dd = sheet(4.0, 40, 0.0);
-  dd.capacity.minimum_extra = 8192;
-  const std::uint32_t gel = world.add_surface(dd);
-  anchor_border(world.surface(gel), 4.0);
-  TopologyAdapter topology(world, {}, {gel});
-  InstrumentSceneOptions o;
-  o.ports_mm = {Vec3(-10, 0, 0.6)};
-  Simulation sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
-  sys.set_topology(&topology);
-  // Shaft along +x just above the sheet, port turned down toward it.
-  InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], Vec3::UnitX(), 10.0, std::numbers::pi);
-  in.pedal = 1.0;
+  VitrectorOverSheet v;
+  TissueWorld& world = v.world;
+  const std::uint32_t gel = v.gel;
+  TopologyAdapter& topology = *v.topology;
+  const InstrumentSceneOptions& o = v.options;
+  Simulation& sys = *v.sys;
+  const InstrumentInput in = v.input;
   const double mass0 = world.surface(gel).total_mass();
   for (int i = 0; i < 300; ++i) {
     ASSERT_TRUE(sys.set_input(0, in));
@@ -857,26 +875,15 @@ TEST(Instruments, TheVitrectorCutsAtTheRateThePedalSets) {
   // nothing; at 600 cuts per minute the guillotine closes twice (at 100 and 200 ms), at the default
   // 7500 cpm 25 times — each cut removing what has entered the port since the last.
   auto run = [](double cut_rate_cpm, int& cuts) {
-    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
-    SurfaceDescription dd = sheet(4.0, 40, 0.0);
-    dd.capacity.minimum_extra = 8192;
-    const std::uint32_t gel = world.add_surface(dd);
-    anchor_border(world.surface(gel), 4.0);
-    TopologyAdapter topology(world, {}, {gel});
-    InstrumentSceneOptions o;
-    o.ports_mm = {Vec3(-10, 0, 0.6)};
-    Simulation sys(world, o, {{InstrumentKind::kVitrector, Gauge::k23, 0, {}}});
-    sys.set_topology(&topology);
-    InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], Vec3::UnitX(), 10.0, std::numbers::pi);
-    in.pedal = 1.0;
-    in.cut_rate_cpm = cut_rate_cpm;
+    VitrectorOverSheet v;
+    v.input.cut_rate_cpm = cut_rate_cpm;
     cuts = 0;
     double removed = 0.0;
     for (int i = 0; i < 200; ++i) {
-      EXPECT_TRUE(sys.set_input(0, in));
-      EXPECT_TRUE(sys.step(kDt).tissue.ok);
-      if (topology.removed_mass_g() > removed) ++cuts;  // a step whose cut took something
-      removed = topology.removed_mass_g();
+      EXPECT_TRUE(v.sys->set_input(0, v.input));
+      EXPECT_TRUE(v.sys->step(kDt).tissue.ok);
+      if (v.topology->removed_mass_g() > removed) ++cuts;  // a step whose cut took something
+      removed = v.topology->removed_mass_g();
     }
     return removed;
   };
