@@ -21,6 +21,9 @@ constexpr double kContactReach_mm = 0.05;
 // How deep the contact terms may let tissue into a capsule before the hard projection acts: their
 // stiffness keeps a few mN of contact within a few µm.
 constexpr double kContactSlack_mm = 0.02;
+// The most the hard projection moves any corner of a triangle, in units of the depth it removes
+// (project_contacts).
+constexpr double kMaxLever = 2.0;
 }  // namespace
 
 double TissueWorld::local_pressure_on(std::uint32_t surface, std::uint32_t vertex) const {
@@ -264,7 +267,15 @@ void TissueWorld::project_contacts(double h, double fraction) {
     if (wsum == 0.0) continue;
     double& deepest = contact_depth_[c.collider];
     deepest = std::max(deepest, depth);
-    const double lambda = depth / wsum;
+    // A point next to a fixed vertex (an anchored rim: the gel's at the vitreous base, a traction
+    // plane's edge held by the vitreous) is a lever: pushing it out by `depth` moves the free corners
+    // by depth·w·b/Σwb², without bound as the point nears the fixed corner — the tissue was flung
+    // tens of millimetres by a shaft passing the rim. No corner moves more than kMaxLever·depth;
+    // with equal masses the lever never exceeds (1+√3)/2 ≈ 1.37, so only anchored triangles are
+    // limited (they stay partly inside for the substep and the contact terms push them on).
+    double lambda = depth / wsum;
+    const double lever = std::max({w[tv[0]] * bc[0], w[tv[1]] * bc[1], w[tv[2]] * bc[2]}) * lambda;
+    if (lever > kMaxLever * depth) lambda *= kMaxLever * depth / lever;
     x0 += (w[tv[0]] * bc[0] * lambda) * n;
     x1 += (w[tv[1]] * bc[1] * lambda) * n;
     x2 += (w[tv[2]] * bc[2] * lambda) * n;

@@ -820,6 +820,44 @@ TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
 // the port turned down toward it. Full suction removes a fifth of the sheet in 300 ms; the
 // guillotine's cuts around the port take more spring and triangle slots on the way than the default
 // reserve.
+// A shaft that lies on a sheet right beside its anchored rim (the vitrector sweeping along a
+// traction plane's edge held by the vitreous, or across the gel's rim at the vitreous base) presses
+// the sheet down by the little it overlaps it. Pushing a point next to a fixed corner out of the
+// shaft used to fling the free corners by depth/(barycentric weight): tens of millimetres.
+TEST(Instruments, AShaftAlongAnAnchoredRimPressesTheSheetAndFlingsNothing) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  const double size = 8.0;
+  const std::uint32_t m = world.add_surface(sheet(size, 40, 0.0));
+  anchor_border(world.surface(m), size);
+  InstrumentSceneOptions o;
+  const double r = shaft_radius_mm(Gauge::k23);
+  const double overlap = 0.12;
+  // Parallel to the rim y = +4, 0.1 mm inside it: the shaft overlaps the anchored row's triangles.
+  const Vec3 port(-10.0, 0.5 * size - 0.1, r - overlap);
+  o.ports_mm = {port};
+  Simulation sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k23, 0, {}}});
+  const int steps = 1600;  // tip from x = -4.5 to x = +3.5 at 5 mm/s
+  for (int i = 0; i <= steps; ++i) {
+    ASSERT_TRUE(sys.set_input(0, InstrumentInput::through_port(port, Vec3::UnitX(), 5.5 + 8.0 * i / steps)));
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+  }
+  const Surface& s = world.surface(m);
+  double moved = 0.0, stretch = 0.0;
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) moved = std::max(moved, (s.position(v) - s.rest_position(v)).norm());
+  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+    if (!s.edge_alive(e)) continue;
+    const auto [a, b] = s.edge_vertices(e);
+    stretch = std::max(stretch, (s.position(b) - s.position(a)).norm() / s.edge_rest_length(e) - 1.0);
+  }
+  // The anchored row lies inside the shaft and cannot leave it, so the free row beside it is
+  // pressed somewhat past the shaft's underside (each substep pushes the contact point again), but
+  // by less than the shaft's width, and no spring comes near a retina's tear strain (0.45).
+  // Before the limit: 1e9 mm.
+  EXPECT_LT(moved, 2.0 * r) << "the sheet was flung by the shaft";
+  EXPECT_GT(moved, 0.5 * overlap) << "the shaft pressed the sheet it lies on";
+  EXPECT_LT(stretch, 0.3);
+}
+
 struct VitrectorOverSheet {
   TissueWorld world{GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()};
   std::uint32_t gel = 0;
