@@ -244,6 +244,12 @@ bool is_strong(const MembraneSpec& m, std::uint32_t index) {
   return false;
 }
 
+// Under a traction membrane the subretinal fluid carries this share of the intraocular pressure
+// at most: the traction holds the retina up against the rest, and once it is cut the retina settles
+// back onto the pigment epithelium, whose pump draws the fluid away (a share of 1 would leave a cut
+// detachment standing wherever it was, with nothing to bring it down).
+constexpr double kSubretinalSupport = 0.9;
+
 BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, const MembraneSpec& spec) {
   const EyeModel& eye = scene.eye;
   TissueWorld& world = scene.world;
@@ -390,14 +396,18 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
       if (dist < spec.detach_radius_mm) {
         const double u = dist / spec.detach_radius_mm;
         lf.vertices.push_back(v);
-        lf.weights.push_back(std::clamp(1.5 * (1.0 - u * u), 0.0, 1.0));
+        lf.weights.push_back(std::clamp(1.5 * (1.0 - u * u), 0.0, kSubretinalSupport));
       }
     }
     if (!lf.vertices.empty()) out.detachment_force = world.add_local_force(lf);
   }
 
   // Contraction (thesis ch. 2.4: rest lengths scaled down).
-  if (spec.kind == MembraneKind::kEpiretinal || spec.kind == MembraneKind::kPerpendicular) {
+  // An epiretinal membrane contracts in its own plane, every way. The traction bands and the
+  // perpendicular plane contract along their fibres: circumferential bands along the circle,
+  // anteroposterior bands along the meridian, and the plane of condensed vitreous toward the
+  // globe's centre (its height), which lifts the retina without puckering it along the plane's base.
+  if (spec.kind == MembraneKind::kEpiretinal) {
     const Status st = ms.set_surface_traction(spec.rest_length_scale);
     if (!st) throw InvalidArgument(what + ": " + st.message());
   } else {
@@ -408,7 +418,10 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
       const Vec3 dir = (ms.position(b) - ms.position(a)).normalized();
       const Vec3 e_phi = Vec3(-mid.y(), mid.x(), 0.0).normalized();
       const double along_circ = std::abs(dir.dot(e_phi));
-      const bool aligned = spec.kind == MembraneKind::kCircumferential ? along_circ > 0.7 : along_circ < 0.5;
+      const double along_radius = std::abs(dir.dot((mid - eye.wall.center()).normalized()));
+      const bool aligned = spec.kind == MembraneKind::kCircumferential ? along_circ > 0.7
+                           : spec.kind == MembraneKind::kPerpendicular ? along_radius > 0.7
+                                                                       : along_circ < 0.5;
       if (aligned) {
         const Status st = ms.set_edge_traction(ms.edge_id(e), spec.rest_length_scale);
         if (!st) throw InvalidArgument(what + ": " + st.message());

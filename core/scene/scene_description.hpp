@@ -55,15 +55,17 @@ struct MembraneSpec {
   double size_mm = 4.0;     // radius (epiretinal), band length (circumferential, anteroposterior, perpendicular)
   double width_mm = 1.5;    // band width
   double height_mm = 2.0;   // perpendicular sheet: height toward the centre
-  double rest_length_scale = 0.9;  // < 1 contracts
+  double rest_length_scale = 0.9;  // < 1 contracts: epiretinal in its plane, bands along them, the
+                                   // perpendicular plane along its height
   AttachmentStrength strength = AttachmentStrength::kMixed;
   double strong_fraction = 0.25;   // kMixed: share of strong attachments (epiretinal: those at the disc are strong)
   int attachment_stride = 3;
   double weak_break_force_un = 40.0;
   double strong_break_force_un = std::numeric_limits<double>::infinity();
-  // Tractional detachment: within this distance (mm) of the membrane, subretinal fluid balances the
-  // intraocular pressure that otherwise holds the retina on the wall, so the traction can lift it
-  // (a local force of IOP toward the centre). 0 = the retina stays pressed on.
+  // Tractional detachment: within this distance (mm) of the membrane, subretinal fluid carries most
+  // of the intraocular pressure that otherwise holds the retina on the wall (90 %, a local force
+  // toward the centre), so the traction can lift it and, cut, lets it settle. 0 = the retina stays
+  // pressed on.
   double detach_radius_mm = 0.0;
 };
 

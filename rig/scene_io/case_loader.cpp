@@ -14,8 +14,9 @@ namespace vitreo::scene_io {
 namespace {
 
 // Bump when the builder changes what a description builds into (or settles into: 2, the solver's
-// tears clean up after themselves, core/topology/clean_topology.hpp).
-constexpr int kBuilderVersion = 2;
+// tears clean up after themselves, core/topology/clean_topology.hpp; 3, the perpendicular traction
+// plane contracts along its height only).
+constexpr int kBuilderVersion = 3;
 
 
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 0xcbf29ce484222325ULL) {
