@@ -7,10 +7,7 @@
 #   install_tree_test.sh BUILD_DIR SOURCE_DIR STAGE PREFIX SYSCONFDIR
 set -u
 build=$1 src=$2 stage=$3 prefix=$4 sysconf=$5
-failures=0
-check() {  # check CONDITION MESSAGE
-  if eval "$1"; then echo "PASS $2"; else echo "FAIL $2"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/checks.sh"
 
 rm -rf "$stage"
 mkdir -p "$(dirname "$stage")"
@@ -61,5 +58,4 @@ systemd-tmpfiles --root="$stage" --create > /dev/null 2>&1
 check "tail -1 '$stage$sysconf/vitreo/rig.toml' | grep -q '^# edited$'" "a second tmpfiles run keeps the edited rig file"
 sed -i '$d' "$stage$sysconf/vitreo/rig.toml"
 
-echo "failures: $failures"
-[ $failures = 0 ]
+finish

@@ -20,10 +20,7 @@ if [ -z "${VITREO_IN_PRIVATE_NS:-}" ]; then
   fi
   VITREO_IN_PRIVATE_NS=1 exec unshare -mn "$0" "$@"
 fi
-failures=0
-check() {  # check CONDITION MESSAGE
-  if eval "$1"; then echo "PASS $2"; else echo "FAIL $2"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/checks.sh"
 tmp=$(mktemp -d)
 # The staged tree is bind-mounted under $tmp: unmount it before removing $tmp, never remove through it.
 trap 'cd /; umount "$tmp/root" 2>/dev/null; [ -z "$(ls -A "$tmp/root" 2>/dev/null)" ] && rm -rf --one-file-system "$tmp"' EXIT
@@ -73,5 +70,4 @@ for d in tracker pedals eyeball; do
 done
 [ $failures = 0 ] || cat unit.txt
 
-echo "failures: $failures"
-[ $failures = 0 ]
+finish

@@ -8,10 +8,7 @@
 set -u
 stage=$1 prefix=$2
 unit=$stage$prefix/lib/systemd/system/vitreo.service
-failures=0
-check() {  # check CONDITION MESSAGE
-  if eval "$1"; then echo "PASS $2"; else echo "FAIL $2"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/checks.sh"
 command -v systemd-analyze > /dev/null || { echo "SKIP: systemd-analyze not installed (package systemd)"; exit 77; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -35,5 +32,4 @@ check "[ -n '$bin' ] && [ -x '$stage$bin' ]" "ExecStart runs $prefix/bin/vitreo,
 for key in 'User=vitreo' 'Group=vitreo' 'Restart=on-failure' 'StateDirectory=vitreo' 'NoNewPrivileges=yes' 'DevicePolicy=closed'; do
   check "grep -qx '$key' '$unit'" "$key"
 done
-echo "failures: $failures"
-[ $failures = 0 ]
+finish

@@ -21,10 +21,7 @@ if [ -z "${VITREO_IN_PRIVATE_NS:-}" ]; then
   unshare -m true 2>/dev/null || { echo "SKIP: 'unshare -m' is not permitted here (needs root)"; exit 77; }
   VITREO_IN_PRIVATE_NS=1 exec unshare -m "$0" "$@"
 fi
-failures=0
-check() {  # check CONDITION MESSAGE
-  if eval "$1"; then echo "PASS $2"; else echo "FAIL $2"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/checks.sh"
 tmp=$(mktemp -d)
 # (All of it is private to this namespace; only the empty $tmp folder is left to remove.)
 trap 'cd /; for m in /dev/pts /dev /run/udev /etc/udev/rules.d /etc/udev/rules.d /etc/group "$tmp"; do umount "$m" 2>/dev/null; done; rmdir "$tmp"' EXIT
@@ -101,5 +98,4 @@ check "grep -q \"70-vitreo.rules:[0-9]* Invalid key 'SYMLNK'\" $tmp/broken.log &
   "a copy with a misspelt key: udev reports it and makes no /dev/vitreo/pedals"
 
 [ $failures = 0 ] || { echo "--- udev's log for the tracker's tty:"; cat "$tmp/tracker-tty.log"; }
-echo "failures: $failures"
-[ $failures = 0 ]
+finish
