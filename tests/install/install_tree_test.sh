@@ -48,6 +48,9 @@ out=$(systemd-sysusers --root="$stage" 2>&1); rc=$?
 check "[ $rc = 0 ]" "systemd-sysusers --root (exit $rc): $out"
 check "grep -q '^vitreo:x:[0-9]*:[0-9]*:.*:/usr/sbin/nologin$' '$stage/etc/passwd'" "user vitreo created (a system user, no login shell)"
 check "grep -q '^vitreo:x:[0-9]*:' '$stage/etc/group'" "group vitreo created"
+for g in $(sed -n 's/^SupplementaryGroups=//p' "$root/lib/systemd/system/vitreo.service"); do
+  check "grep -q '^$g:x:' '$stage/etc/group'" "group $g, a supplementary group of the unit, is made where it is missing"
+done
 out=$(systemd-tmpfiles --root="$stage" --create 2>&1); rc=$?
 check "[ $rc = 0 ]" "systemd-tmpfiles --root --create (exit $rc)${out:+: $out}"
 check "cmp -s '$stage$sysconf/vitreo/rig.toml' '$root/share/vitreo/config/installed-rig.toml'" \
