@@ -8,7 +8,8 @@
 #   - vitreo-cases lists the installed cases;
 #   - vitreo with the unit's own options (vitreo.service's ExecStart, a short duration) on the rig
 #     file systemd-tmpfiles put in place: no device is plugged in here, so each one is lost and
-#     retried while the session runs, as on a rig switched on before its devices.
+#     retried while the session runs, as on a rig switched on before its devices; its system calls
+#     and socket families (strace) are within what the unit's sandbox allows.
 # Runs in private mount and network namespaces (LCM multicast on a private loopback); exits 77
 # (CTest skip) where `unshare` is not permitted.
 #   installed_vitreo_test.sh STAGE PREFIX SYSCONFDIR SOURCE_DIR
@@ -57,8 +58,13 @@ unit=$root/lib/systemd/system/vitreo.service
 script=$(sed -n "s|^ExecStart=/bin/sh -c '\\(.*\\)'\$|\\1|p" "$unit" | sed -e 's/\$\$/$/g' -e 's/%%/%/g' \
   -e "s| $prefix/bin/vitreo | $root/bin/vitreo |" -e "s| --rig $sysconf/| --rig $tmp/root$sysconf/|" -e 's/--duration 36000/--duration 0.3/')
 check "[ -n \"\$script\" ]" "the unit's ExecStart read"
+# Under strace where it is installed: the unit's sandbox allows the system calls of
+# @system-service and the socket families it lists, and everything this session calls must be in
+# them (systemd's own lists, expanded by systemd-analyze).
+trace=
+command -v strace > /dev/null && trace="strace -f -qq -o $tmp/strace.txt"
 STATE_DIRECTORY=$tmp/state CACHE_DIRECTORY=$tmp/cache VITREO_LCM_URL='udpm://239.255.76.67:7667?ttl=0' VITREO_OPTIONS='--retina-vertices 500' \
-  sh -c "$script" > unit.txt 2>&1
+  $trace sh -c "$script" > unit.txt 2>&1
 rc=$?
 check "[ $rc = 0 ]" "vitreo runs with the unit's options on the installed rig file (exit $rc)"
 check "grep -q 'rig $tmp/root$sysconf/vitreo/rig.toml: 3 device(s)' unit.txt" "it read the rig file"
@@ -69,5 +75,23 @@ for d in tracker pedals eyeball; do
   check "grep -q '^  device  *$d  *frames 0,' unit.txt && grep -q 'device $d: lost -> reconnecting' unit.txt" "$d absent: lost and retried"
 done
 [ $failures = 0 ] || cat unit.txt
+if [ -n "$trace" ]; then
+  expand() {  # expand @GROUP: its system calls, nested groups expanded
+    systemd-analyze syscall-filter "$1" | sed -e '1d' -e 's/#.*//' | awk 'NF {print $1}' |
+      while read -r x; do case $x in @*) expand "$x" ;; *) echo "$x" ;; esac; done
+  }
+  filter=$(sed -n 's/^SystemCallFilter=//p' "$unit")
+  for g in $filter; do expand "$g"; done | sort -u > allowed.txt
+  sed -n 's/^[0-9]*  *\([a-z_0-9]*\)(.*/\1/p' "$tmp/strace.txt" | sort -u > called.txt
+  outside=$(comm -23 called.txt allowed.txt | tr '\n' ' ')
+  check "[ -s allowed.txt ] && [ -z '$outside' ]" \
+    "the session's $(wc -l < called.txt) system calls are all in SystemCallFilter=$filter${outside:+ (not: $outside)}"
+  families=$(sed -n 's/^RestrictAddressFamilies=//p' "$unit")
+  used=$(sed -n 's/^[0-9]*  *socket(\(AF_[A-Z0-9]*\),.*/\1/p' "$tmp/strace.txt" | sort -u | tr '\n' ' ')
+  stray=$(for f in $used; do case " $families " in *" $f "*) ;; *) printf '%s ' "$f" ;; esac; done)
+  check "[ -n '$used' ] && [ -z '$stray' ]" "its sockets ($used) are in RestrictAddressFamilies=$families${stray:+ (not: $stray)}"
+else
+  echo "NOTE strace not installed: the session's system calls were not checked against the unit's filter"
+fi
 
 finish
