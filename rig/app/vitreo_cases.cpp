@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
 
   std::string dir;
   auto* list = app.add_subcommand("list", "list the cases in a directory, each with its surgical scripts (DIR/scripts)");
-  list->add_option("--dir", dir, "directory of scene files (default: ./scenes, else the installed cases)");
+  list->add_option("--dir", dir, "directory of scene files (default: ./scenes, else the installed cases, else the source tree's)");
 
   std::vector<std::string> files;
   auto* validate = app.add_subcommand("validate", "parse and build scene files; non-zero exit on the first bad one");

@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
                            ->check(vitreo::app::finite_range(0.01, 36000.0));
   auto* case_opt = app.add_option("--case", case_files, "a case file (repeatable: the case list, in order; the first starts)")
                        ->check(CLI::ExistingFile);
-  auto* cases_opt = app.add_option("--cases", cases_dir, "every *.toml case in this folder, sorted (default: ./scenes, else the installed cases)")
+  auto* cases_opt = app.add_option("--cases", cases_dir, "every *.toml case in this folder, sorted (default: ./scenes, else the installed cases, else the source tree's)")
                         ->check(CLI::ExistingDirectory);
   auto* start_opt =
       app.add_option("--start", first_case, "with --cases: the file name to start with (default low_membrane_macula.toml)");
