@@ -4,7 +4,7 @@
 #   bin/                          vitreo, vitreo-cmd, vitreo-report, vitreo-cases, vitreo-devices, vitreo-calibrate
 #   share/vitreo/scenes/          the cases, their materials library and surgical scripts (scripts/)
 #   share/vitreo/config/          example rig files (and the simulated devices' scripts, sim/)
-#   share/doc/vitreo/             README.md and the documents the tools refer to
+#   share/doc/vitreo/             README.md and the documents it refers to (rig/system/README.md: the service)
 #   lib/systemd/system/           vitreo.service
 #   lib/sysusers.d/vitreo.conf    the user and group vitreo
 #   lib/tmpfiles.d/vitreo.conf    /etc/vitreo/rig.toml from the installed example, when there is none
@@ -37,8 +37,14 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/scenes/ DESTINATION ${VITREO_DATA_DIR}/s
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/config/ DESTINATION ${VITREO_DATA_DIR}/config
         FILES_MATCHING PATTERN "*.toml" PATTERN "*.sim")
 
-install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
-install(FILES ${PROJECT_SOURCE_DIR}/rig/system/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} RENAME installed-rig.md)
+# README.md and the documents it points users to, at the same relative paths (the cases' own
+# READMEs are beside them in share/vitreo/scenes/).
+foreach(doc README.md firmware-protocol/PROTOCOL.md drivers/README.md core/README.md core/metrics/README.md
+            rig/calibration/README.md rig/report/README.md rig/runtime/README.md rig/system/README.md
+            rig/telemetry/CHANNELS.md rig/telemetry/RECORDING.md)
+  get_filename_component(_doc_dir ${doc} DIRECTORY)
+  install(FILES ${PROJECT_SOURCE_DIR}/${doc} DESTINATION ${CMAKE_INSTALL_DOCDIR}/${_doc_dir})
+endforeach()
 
 # The rig process as a service, its user, its rig file's place, its devices' names.
 configure_file(${PROJECT_SOURCE_DIR}/rig/system/vitreo.service.in ${PROJECT_BINARY_DIR}/rig/system/vitreo.service @ONLY)

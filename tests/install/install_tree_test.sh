@@ -22,7 +22,7 @@ for b in vitreo vitreo-cmd vitreo-report vitreo-cases vitreo-devices vitreo-cali
 done
 for f in lib/systemd/system/vitreo.service lib/udev/rules.d/70-vitreo.rules lib/sysusers.d/vitreo.conf \
          lib/tmpfiles.d/vitreo.conf share/vitreo/config/installed-rig.toml share/vitreo/scenes/materials.toml \
-         share/doc/vitreo/README.md share/doc/vitreo/installed-rig.md; do
+         share/doc/vitreo/README.md share/doc/vitreo/rig/system/README.md share/doc/vitreo/firmware-protocol/PROTOCOL.md; do
   check "[ -s '$root/$f' ]" "$f installed"
 done
 # Every case, script and rig file of the source tree, byte for byte (listed from the source tree,
