@@ -22,6 +22,9 @@ packages=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   umockdev libumockdev-dev can-utils iproute2 util-linux
+  # the install tests: systemd-analyze, -sysusers, -tmpfiles check the unit and snippets; udevadm
+  # runs the udev rules; strace lists the system calls the unit's sandbox must allow
+  systemd udev strace
   # SocketCAN and KMS display tests run inside a small qemu VM (the host kernel has neither)
   qemu-system-x86 linux-image-amd64 busybox-static cpio
   # protocol fuzz targets: clang's libFuzzer (GCC has none)

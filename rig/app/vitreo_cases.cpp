@@ -14,6 +14,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "rig/files/data_dir.hpp"
 #include "rig/session/surgical_script.hpp"
 #include "core/scene/scene_builder.hpp"
 #include "core/scene/snapshot.hpp"
@@ -198,9 +199,9 @@ int main(int argc, char** argv) {
   CLI::App app{"vitreo-cases: list, validate and inspect the surgical cases (scene files)"};
   app.require_subcommand(1);
 
-  std::string dir = "scenes";
+  std::string dir;
   auto* list = app.add_subcommand("list", "list the cases in a directory, each with its surgical scripts (DIR/scripts)");
-  list->add_option("--dir", dir, "directory of scene files")->capture_default_str();
+  list->add_option("--dir", dir, "directory of scene files (default: ./scenes, else the installed cases, else the source tree's)");
 
   std::vector<std::string> files;
   auto* validate = app.add_subcommand("validate", "parse and build scene files; non-zero exit on the first bad one");
@@ -221,7 +222,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    if (*list) return cmd_list(dir);
+    if (*list) return cmd_list(dir.empty() ? vitreo::files::default_scenes_dir() : dir);
     if (*validate) return cmd_validate(files);
     if (*inspect) return cmd_inspect(file, !no_settle, snapshot);
   } catch (const std::exception& e) {

@@ -24,6 +24,7 @@
 
 #include "rig/app/cli_checks.hpp"
 #include "rig/app/stop_signals.hpp"
+#include "rig/files/data_dir.hpp"
 #include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/report/trainee_history.hpp"
@@ -32,10 +33,6 @@
 #include "rig/session/rig_session.hpp"
 #include "rig/session/scripted_session.hpp"
 
-#ifndef VITREO_SCENES_DIR
-#define VITREO_SCENES_DIR "scenes"
-#endif
-
 namespace {
 
 using vitreo::core::Vec3;
@@ -43,12 +40,6 @@ namespace fs = std::filesystem;
 
 // The case a first-time user sees: a membrane peel shows approach, grasp and pull at a glance.
 constexpr const char* kDefaultCase = "low_membrane_macula.toml";
-
-std::string default_scenes_dir() {
-  std::error_code ec;
-  if (fs::is_directory("scenes", ec)) return "scenes";
-  return VITREO_SCENES_DIR;
-}
 
 // Every *.toml in `dir` except the materials library, sorted by name (the case list order).
 std::vector<std::string> cases_in(const std::string& dir) {
@@ -137,7 +128,7 @@ int main(int argc, char** argv) {
                            ->check(vitreo::app::finite_range(0.01, 36000.0));
   auto* case_opt = app.add_option("--case", case_files, "a case file (repeatable: the case list, in order; the first starts)")
                        ->check(CLI::ExistingFile);
-  auto* cases_opt = app.add_option("--cases", cases_dir, "every *.toml case in this folder, sorted (default: scenes/)")
+  auto* cases_opt = app.add_option("--cases", cases_dir, "every *.toml case in this folder, sorted (default: ./scenes, else the installed cases, else the source tree's)")
                         ->check(CLI::ExistingDirectory);
   auto* start_opt =
       app.add_option("--start", first_case, "with --cases: the file name to start with (default low_membrane_macula.toml)");
@@ -275,7 +266,7 @@ int main(int argc, char** argv) {
     // The case list: --case files in order, or a folder's cases (scenes/ by default).
     std::vector<std::string> files = case_files;
     if (files.empty()) {
-      files = cases_in(cases_dir.empty() ? default_scenes_dir() : cases_dir);
+      files = cases_in(cases_dir.empty() ? vitreo::files::default_scenes_dir() : cases_dir);
       const std::string start = first_case.empty() ? kDefaultCase : first_case;
       const auto it = std::find_if(files.begin(), files.end(), [&](const std::string& f) { return fs::path(f).filename() == start; });
       if (it == files.end() && !first_case.empty()) throw std::runtime_error("--start " + first_case + ": not in the case folder");

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -334,6 +335,47 @@ void test_tool_over_can() {
   CHECK(wait_for(sim) == 0, "simulate stops cleanly on SIGTERM");
 }
 
+// A USB CAN adapter pulled out and plugged back: the kernel unregisters its interface and
+// registers a new one under the same name (another ifindex). The driver must see the interface go
+// (lost), keep retrying by name while it is away, and stream again from the fixture behind it
+// once it is back — the same as the serial driver reopening its /dev/vitreo path.
+void test_interface_removed_and_added_again() {
+  std::printf("== the CAN interface removed and added again (an adapter re-plugged)\n");
+  ManualClock clock;
+  auto fixture = std::make_unique<sim::CanSimDevice>(sim::default_script(sim::DeviceKind::eyeball), kIf, 33, false);
+  CanDevice drv(kIf, 33, false, clock);
+  auto run = [&](int ms) {
+    for (int i = 0; i < ms; ++i) {
+      clock.advance_us(1000);
+      if (fixture) fixture->step(clock.now_us());
+      drv.poll(0);
+    }
+  };
+  run(300);
+  CHECK(drv.session().state() == LinkState::streaming, "streaming before the adapter is pulled (state %s)",
+        to_string(drv.session().state()));
+  const unsigned old_index = if_nametoindex(kIf);
+  CHECK(wait_for(spawn({"ip", "link", "delete", "dev", kIf})) == 0, "ip link delete %s", kIf);
+  fixture.reset();  // its socket went with the interface
+  run(300);
+  CHECK(drv.session().state() == LinkState::lost || drv.session().state() == LinkState::reconnecting,
+        "interface gone → lost (state %s)", to_string(drv.session().state()));
+  const auto samples_before = drv.session().stats().samples_delivered;
+  CHECK(wait_for(spawn({"ip", "link", "add", "dev", kIf, "type", "vcan"})) == 0 &&
+            wait_for(spawn({"ip", "link", "set", kIf, "mtu", "72"})) == 0 && wait_for(spawn({"ip", "link", "set", kIf, "up"})) == 0,
+        "ip link add %s again", kIf);
+  CHECK(if_nametoindex(kIf) != 0 && if_nametoindex(kIf) != old_index, "a new interface under the old name (index %u, was %u)",
+        if_nametoindex(kIf), old_index);
+  fixture = std::make_unique<sim::CanSimDevice>(sim::default_script(sim::DeviceKind::eyeball), kIf, 33, false);
+  CHECK(fixture->ok(), "the fixture is on the new interface: %s", fixture->error().c_str());
+  run(600);
+  CHECK(drv.session().state() == LinkState::streaming, "found again by its interface name and streaming (state %s)",
+        to_string(drv.session().state()));
+  CHECK(drv.session().stats().reconnects == 1, "one reconnect (%llu)", (unsigned long long)drv.session().stats().reconnects);
+  CHECK(drv.session().stats().samples_delivered > samples_before + 50, "samples again: %llu more",
+        (unsigned long long)(drv.session().stats().samples_delivered - samples_before));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -353,6 +395,7 @@ int main(int argc, char** argv) {
   test_candump_reads_our_frames();
   test_cansend_vectors_reach_our_decoder();
   test_tool_over_can();
+  test_interface_removed_and_added_again();  // last: it replaces vcan0
   std::printf("@@CAN %s: %d checks, %d failed@@\n", g_fail ? "FAIL" : "PASS", g_checks, g_fail);
   return g_fail ? 1 : 0;
 }

@@ -72,6 +72,23 @@ TEST(RigFile, TheBuiltRigNamesRealDevicesAndCarriesThePedalMapping) {
   EXPECT_EQ(f.pedals->cut_rate_max_cpm, 10000.0);
 }
 
+// The rig file the installed service reads (rig/system/): its serial devices by the names
+// 70-vitreo.rules gives them (tests/install/udev_rules_test.sh checks udev makes them).
+TEST(RigFile, TheInstalledRigNamesItsDevicesByTheirStableNames) {
+  const rig::RigFile f = rig::read_rig_file(kConfig + "/installed-rig.toml");
+  ASSERT_EQ(f.devices.size(), 3u);
+  EXPECT_EQ(f.devices[0].uri, "serial:/dev/vitreo/tracker");
+  EXPECT_EQ(f.devices[1].uri, "serial:/dev/vitreo/pedals");
+  EXPECT_EQ(f.devices[2].uri, "can:can0?node=33");
+  for (const auto& d : f.devices) {
+    if (d.uri.rfind("serial:", 0) == 0) {
+      EXPECT_EQ(d.uri, "serial:/dev/vitreo/" + d.name) << "a device is named as its /dev/vitreo link";
+    }
+  }
+  EXPECT_FALSE(f.pedals.has_value()) << "the default mapping";
+  EXPECT_TRUE(f.calibration_path.empty());
+}
+
 TEST(RigFile, FieldsReachTheSpec) {
   const auto dir = std::filesystem::temp_directory_path() / ("rig-file-test-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
