@@ -43,6 +43,13 @@ void SimulationModel::install(std::unique_ptr<PreparedCase> c) {
 int SimulationModel::selected_tool() const {
   const auto n = case_->tools.size();
   if (n == 0) return -1;
+  // A handpiece that names its tool (the tracker's tool type) puts that tool in the working hand
+  // when the case offers it: a blade cannot be switched into forceps. A universal handpiece (tool
+  // type 0), or one naming a tool the case lacks, leaves the choice to the instrument switch.
+  if (core::InstrumentKind named; instrument_kind_of_tool_type(instruments_[kToolTracker].tool_type, named)) {
+    const auto it = std::find(case_->tools.begin(), case_->tools.end(), named);
+    if (it != case_->tools.end()) return static_cast<int>(it - case_->tools.begin());
+  }
   return static_cast<int>(pedals_.controls().instrument_changes % n);
 }
 
@@ -197,6 +204,7 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_u64(refused_);
   for (const auto& slot : instruments_) {
     h.add_u64((slot.present ? 1u : 0u) | (slot.frozen ? 2u : 0u) | (slot.pose.inserted ? 4u : 0u));
+    h.add_u64(static_cast<std::uint64_t>(slot.tool_type));  // it picks the working hand's tool
     h.add_vec3(slot.pose.tip_mm);
     h.add_vec3(slot.pose.axis);
     h.add_double(slot.pose.roll_rad);

@@ -113,7 +113,8 @@ class SimulationModel {
   int case_count() const { return static_cast<int>(config_.cases.size()); }
   const ModelConfig& config() const { return config_; }
   std::uint64_t case_loads() const { return case_loads_; }
-  // The hand-held tool tracker 0 drives now (index into current_case().tools; -1: none).
+  // The hand-held tool tracker 0 drives now (index into current_case().tools; -1: none): the tool
+  // its handpiece names (tool type) when the case offers it, else the instrument switch's choice.
   int selected_tool() const;
   const SurgicalControls& controls() const { return pedals_.controls(); }
   const std::array<InstrumentSlot, 4>& instruments() const { return instruments_; }

@@ -11,6 +11,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "firmware-protocol/vp.h"
 #include "rig/files/read_text_file.hpp"
 #include "rig/files/toml_guard.hpp"
 
@@ -478,14 +479,18 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       if (w.hold_s > 0.0) add_segment(pos, jaws, w.hold_s / script.speed_scale, std::nullopt);
     }
     const std::string name = "tracker-" + std::to_string(hand.tracker);
-    std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool 3\ninstrument " +
+    // The working hand holds a universal handpiece (tool type 0): the script's `tool =` picks the
+    // tool with instrument-switch presses. The other hand's handpiece is the light pipe.
+    const int tool_type = hand.tracker == kToolTracker ? VP_TOOL_NONE : VP_TOOL_LIGHT_PIPE;
+    std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool " +
+                         std::to_string(tool_type) + "\ninstrument " +
                          std::to_string(hand.tracker) + "\nloop 0\nseed " + std::to_string(script.seed + static_cast<std::uint64_t>(hand.tracker)) + "\n";
     out.device_scripts[name] = header + keys;
   }
 
   if (!out.device_scripts.count("tracker-0")) {  // no working hand scripted: it stays outside the eye
     const Port& port = c.tracker_ports[kToolTracker];
-    out.device_scripts["tracker-0"] = "device tracker\nrate_hz 1000\nserial 1001\ntool 3\ninstrument 0\nloop 0\nseed " +
+    out.device_scripts["tracker-0"] = "device tracker\nrate_hz 1000\nserial 1001\ntool 0\ninstrument 0\nloop 0\nseed " +
                                       std::to_string(script.seed) + "\n" + tracker_key(0, port.position_mm + 2.0 * port.outward, 0);
   }
 

@@ -196,6 +196,11 @@ TEST_F(Resolving, PedalsAndToolSwitchesFollowTheWaypoints) {
   }
   EXPECT_EQ(presses, 1);
   EXPECT_DOUBLE_EQ(last_vacuum, 0.5);
+  // The presses choose the tool only because the working hand's handpiece names none (tool type 0):
+  // a handpiece that names its tool would pin it (rig/runtime/README.md, tracker mapping).
+  drivers::sim::Script hand;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("tracker-0"), hand, &err)) << err;
+  EXPECT_EQ(hand.tool, 0);
 }
 
 }  // namespace
