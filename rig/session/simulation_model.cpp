@@ -15,7 +15,7 @@ SimulationModel::SimulationModel(const ModelConfig& config)
     : SimulationModel(config, prepare_case(config.cases, config.first_case, config.load)) {}
 
 SimulationModel::SimulationModel(const ModelConfig& config, std::unique_ptr<PreparedCase> first)
-    : config_(config), pedals_(config.pedals) {
+    : config_(config), pedals_(config.pedals), laser_(config.laser) {
   if (!first) throw std::invalid_argument("SimulationModel: no case");
   install(std::move(first));
   case_loads_ = 0;  // the first case is the start, not a switch
@@ -74,6 +74,7 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       ok = true;
     }
   } else if (in.device_kind == kCommandKind && in.n_values >= 2) {
+    ok = true;
     // Codes follow telemetry::CommandCode. Case changes, reset and snapshots are carried out by the
     // session (a case is loaded off the physics thread; its arrival is a kCaseKind input).
     switch (static_cast<int>(in.values[0])) {
@@ -88,9 +89,11 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       case 12: flat_shading_ = !flat_shading_; break;
       case 13: microscope_.toggle_wide_angle(); break;
       case 14: microscope_.toggle_reinverter(); break;
+      // The laser's settings, held to the commands' ranges here too (a recording could say anything).
+      case 15: ok = laser_power_in_range(in.values[1]); if (ok) laser_.power_mw = in.values[1]; break;
+      case 16: ok = laser_duration_in_range(in.values[1]); if (ok) laser_.duration_ms = in.values[1]; break;
       default: break;
     }
-    ok = true;
   } else if (in.device_kind == kLinkKind && in.n_values >= 1) {
     // Which instrument a tracker link carries is its channel; the pedals' and the fixture's links
     // freeze no instrument (values[1]: the device's type, 1 a tracker; absent in older recordings).
@@ -180,6 +183,8 @@ core::StepReport SimulationModel::step() {
     // The laser switch fires the tool in the working hand, nothing else (the light pipe's pick used
     // to stick out at every shot).
     in.trigger = static_cast<int>(i) == tool && c.laser_fire;
+    in.laser_power_mw = laser_.power_mw;  // the console's settings: each shot one pulse of these
+    in.laser_duration_s = 1e-3 * laser_.duration_ms;
     in.light_power_mw = 5.0 + 10.0 * c.light_level;
     (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
@@ -220,6 +225,8 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
   h.add_u64(c.air_infusion ? 1u : 0u);
+  h.add_double(laser_.power_mw);
+  h.add_double(laser_.duration_ms);
   h.add_double(eye_rotation_.w());
   h.add_double(eye_rotation_.x());
   h.add_double(eye_rotation_.y());

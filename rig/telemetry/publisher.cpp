@@ -264,6 +264,8 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.laser_fire = v.laser_fire;
           m.light_level = v.light_level;
           m.zoom = v.zoom;
+          m.laser_power_mw = v.laser_power_mw;
+          m.laser_duration_ms = v.laser_duration_ms;
           rc = publish(lcm_, kChanControls, m);
         }
       },
