@@ -441,6 +441,7 @@ SessionSummary run_session(const SessionConfig& config) {
       ctl.cut_rate_cpm = c.cut_rate_cpm;
       ctl.reflux = c.reflux;
       ctl.laser_fire = c.laser_fire;
+      ctl.pick_out = c.pick_out;
       ctl.light_level = c.light_level;
       ctl.zoom = c.zoom;
       ctl.laser_power_mw = model.laser().power_mw;

@@ -180,9 +180,9 @@ core::StepReport SimulationModel::step() {
     }
     in.pedal = std::clamp(vacuum, 0.0, 1.0);
     in.cut_rate_cpm = c.cut_rate_cpm;  // the vitrector's cutter, from the pedal (controls.hpp)
-    // The laser switch fires the tool in the working hand, nothing else (the light pipe's pick used
-    // to stick out at every shot).
-    in.trigger = static_cast<int>(i) == tool && c.laser_fire;
+    // The laser switch fires the tool in the working hand; the light pipe's pick has its own switch
+    // (it used to stick out at every shot, then not at all).
+    in.trigger = static_cast<int>(i) == case_->light_pipe ? c.pick_out : static_cast<int>(i) == tool && c.laser_fire;
     in.laser_power_mw = laser_.power_mw;  // the console's settings: each shot one pulse of these
     in.laser_duration_s = 1e-3 * laser_.duration_ms;
     in.light_power_mw = 5.0 + 10.0 * c.light_level;
@@ -225,6 +225,7 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
   h.add_u64(c.air_infusion ? 1u : 0u);
+  h.add_u64((c.laser_fire ? 1u : 0u) | (c.pick_out ? 2u : 0u) | (c.reflux ? 4u : 0u));
   h.add_double(laser_.power_mw);
   h.add_double(laser_.duration_ms);
   h.add_double(eye_rotation_.w());

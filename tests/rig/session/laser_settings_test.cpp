@@ -6,65 +6,25 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <string>
 
 #include "firmware-protocol/vp.h"
-#include "rig/scene_io/case_loader.hpp"
-#include "rig/session/device_inputs.hpp"
-#include "rig/session/simulation_model.hpp"
+#include "tests/rig/session/model_inputs.hpp"
 
 using namespace vitreo;
 
 namespace {
 
-const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
+rig::ModelConfig laser_case() { return test::light_case("exercise_laser_tear.toml"); }
 
-rig::ModelConfig laser_case() {
-  rig::ModelConfig m;
-  m.cases.push_back(scene_io::read_case_text(kScenes + "/exercise_laser_tear.toml"));
-  m.load.retina_vertices = 1500;
-  m.load.texture_size_px = 128;
-  m.load.cache_dir = (std::filesystem::path(::testing::TempDir()) / "vitreo-laser-settings-cache").string();
-  return m;
-}
-
-telemetry::DeviceInput command(int code, double value) {
-  telemetry::DeviceInput in;
-  in.device_kind = rig::kCommandKind;
-  in.n_values = 2;
-  in.values[0] = code;
-  in.values[1] = value;
-  return in;
-}
-
-// The vitrectomy pedal at rest, with the laser switch (bit 1 by default) held or not.
-telemetry::DeviceInput pedal(bool laser) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
-  in.n_values = 7;
-  in.values[0] = 0;  // pedal id: vitrectomy
-  in.values[1] = 2;  // axis count
-  in.values[6] = laser ? 1u << rig::PedalMapping{}.laser_switch : 0u;
-  return in;
-}
+telemetry::DeviceInput pedal(bool laser) { return test::pedal_switches(laser ? 1u << rig::PedalMapping{}.laser_switch : 0u); }
 
 // The endolaser 4 mm into its port, aimed at the case's region of interest.
 void hold_the_laser(rig::SimulationModel& model) {
   const rig::PreparedCase& c = model.current_case();
   const core::Vec3 port = c.tracker_ports[rig::kToolTracker].position_mm;
   const core::Vec3 tip = port + 4.0 * (c.focus_mm - port).normalized();
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
-  in.values[0] = tip.x();
-  in.values[1] = tip.y();
-  in.values[2] = tip.z();
-  in.values[3] = 1.0;  // q w
-  in.values[8] = 1.0;  // quality
-  in.values[9] = 0.0;  // the working hand
-  in.values[10] = VP_TOOL_LASER;
-  ASSERT_TRUE(model.apply(in));
+  ASSERT_TRUE(model.apply(test::tracker_sample(tip, VP_TOOL_LASER)));
 }
 
 // One shot: the laser switch pressed for a step and released. Returns the burn it made.
@@ -89,20 +49,20 @@ TEST(LaserSettings, CommandsSetTheShotsAndTheBurnsAreSizedByTheirEnergy) {
   EXPECT_DOUBLE_EQ(first.duration_s, 0.1);
   ASSERT_GT(first.diameter_mm, 0.0);
 
-  ASSERT_TRUE(model.apply(command(15, 400.0)));  // laser_power 400
+  ASSERT_TRUE(model.apply(test::operator_command(15, 400.0)));  // laser_power 400
   const core::BurnSpot doubled = shoot(model);
   EXPECT_EQ(doubled.power_mw, 400.0);
   EXPECT_NEAR(doubled.diameter_mm / first.diameter_mm, std::sqrt(2.0), 1e-9) << "twice the energy";
 
-  ASSERT_TRUE(model.apply(command(16, 50.0)));  // laser_duration 50: 400 mW × 50 ms, the first shot's energy
+  ASSERT_TRUE(model.apply(test::operator_command(16, 50.0)));  // laser_duration 50: 400 mW × 50 ms, the first shot's energy
   const core::BurnSpot halved = shoot(model);
   EXPECT_DOUBLE_EQ(halved.duration_s, 0.05);
   EXPECT_NEAR(halved.diameter_mm / first.diameter_mm, 1.0, 1e-9);
 
   // Out of range (a recording could say so): refused, counted, the settings stay.
   const std::uint64_t refused = model.inputs_refused();
-  EXPECT_FALSE(model.apply(command(15, 2500.0)));
-  EXPECT_FALSE(model.apply(command(16, 0.0)));
+  EXPECT_FALSE(model.apply(test::operator_command(15, 2500.0)));
+  EXPECT_FALSE(model.apply(test::operator_command(16, 0.0)));
   EXPECT_EQ(model.inputs_refused(), refused + 2);
   EXPECT_EQ(model.laser().power_mw, 400.0);
   EXPECT_EQ(model.laser().duration_ms, 50.0);

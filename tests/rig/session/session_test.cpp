@@ -28,6 +28,7 @@
 #include "rig/session/snapshot_writer.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "rig/session/device_inputs.hpp"
+#include "tests/rig/session/model_inputs.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/physics_timing_t.hpp"
@@ -476,14 +477,7 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
   const rig::ModelConfig mc = small_model();
   rig::SimulationModel model(mc);
   rig::SimulationModel fresh(mc);
-  auto command = [](int code, double value) {
-    telemetry::DeviceInput in;
-    in.device_kind = rig::kCommandKind;
-    in.n_values = 2;
-    in.values[0] = code;
-    in.values[1] = value;
-    return in;
-  };
+  const auto command = test::operator_command;
   for (int i = 0; i < 50; ++i) model.step();
   const auto moved = model.world().state_hash();
   EXPECT_NE(moved, fresh.world().state_hash());

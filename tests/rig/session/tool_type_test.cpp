@@ -4,48 +4,26 @@
 // leaves the instrument switch's choice, the forceps, which cuts nothing.
 #include <gtest/gtest.h>
 
-#include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include "core/instruments/instrument.hpp"
 #include "firmware-protocol/vp.h"
-#include "rig/scene_io/case_loader.hpp"
-#include "rig/session/device_inputs.hpp"
-#include "rig/session/simulation_model.hpp"
+#include "tests/rig/session/model_inputs.hpp"
 
 using namespace vitreo;
 
 namespace {
 
-const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
-
 // exercise_pull_tissue offering a blade and a sideways blade after its forceps and pick, lightened.
 rig::ModelConfig blade_case() {
-  scene_io::CaseText c = scene_io::read_case_text(kScenes + "/exercise_pull_tissue.toml");
+  rig::ModelConfig m = test::light_case("exercise_pull_tissue.toml");
+  std::string& text = m.cases[0].text;
   const std::string from = "available = [\"forceps\", \"pick\",";
-  const auto at = c.text.find(from);
+  const auto at = text.find(from);
   if (at == std::string::npos) throw std::runtime_error("exercise_pull_tissue's instrument list changed");
-  c.text.replace(at, from.size(), "available = [\"forceps\", \"pick\", \"blade\", \"sideways_blade\",");
-  rig::ModelConfig m;
-  m.cases.push_back(c);
-  m.load.retina_vertices = 1500;
-  m.load.texture_size_px = 128;
-  m.load.cache_dir = (std::filesystem::path(::testing::TempDir()) / "vitreo-tool-type-cache").string();
+  text.replace(at, from.size(), "available = [\"forceps\", \"pick\", \"blade\", \"sideways_blade\",");
   return m;
-}
-
-telemetry::DeviceInput tracker_sample(const core::Vec3& tip, int tool_type) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
-  in.values[0] = tip.x();
-  in.values[1] = tip.y();
-  in.values[2] = tip.z();
-  in.values[3] = 1.0;  // q w
-  in.values[8] = 1.0;  // quality
-  in.values[9] = 0.0;  // instrument id: the working hand's tracker
-  in.values[10] = tool_type;
-  return in;
 }
 
 // Sweeps the working hand's tip 1.5 mm across the case's region of interest, 0.15 mm into the
@@ -59,7 +37,7 @@ std::uint32_t sweep_across_the_retina(rig::SimulationModel& model, int tool_type
   const int steps = 100;
   for (int s = 0; s <= steps; ++s) {
     const core::Vec3 tip = centre + (-0.75 + 1.5 * s / steps) * across;
-    EXPECT_TRUE(model.apply(tracker_sample(tip, tool_type)));
+    EXPECT_TRUE(model.apply(test::tracker_sample(tip, tool_type)));
     model.step();
   }
   return c.topology->springs_opened();
@@ -113,12 +91,12 @@ TEST(ToolType, ASidewaysBladeIsPickedTooAndAToolTheCaseLacksLeavesTheSwitch) {
   const rig::PreparedCase& c = model.current_case();
   const core::Vec3 tip = c.tracker_ports[rig::kToolTracker].position_mm +
                          4.0 * (c.focus_mm - c.tracker_ports[rig::kToolTracker].position_mm).normalized();
-  ASSERT_TRUE(model.apply(tracker_sample(tip, VP_TOOL_SIDEWAYS_BLADE)));
+  ASSERT_TRUE(model.apply(test::tracker_sample(tip, VP_TOOL_SIDEWAYS_BLADE)));
   model.step();
   EXPECT_EQ(model.selected_tool(), 3);
   EXPECT_EQ(model.simulation().instrument(3).description.kind, core::InstrumentKind::kSidewaysBlade);
   EXPECT_TRUE(model.simulation().instrument(3).input.present);
-  ASSERT_TRUE(model.apply(tracker_sample(tip, VP_TOOL_VITRECTOR)));  // not offered by this case
+  ASSERT_TRUE(model.apply(test::tracker_sample(tip, VP_TOOL_VITRECTOR)));  // not offered by this case
   model.step();
   EXPECT_EQ(model.selected_tool(), 0);
   EXPECT_TRUE(model.simulation().instrument(0).input.present);

@@ -209,6 +209,7 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   k.cut_rate_cpm = 5000;
   k.reflux = true;
   k.laser_fire = true;
+  k.pick_out = true;
   k.light_level = 0.7;
   k.zoom = 1.5;
   k.laser_power_mw = 350;
@@ -273,6 +274,7 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   EXPECT_DOUBLE_EQ(kg.cut_rate_cpm, 5000);
   EXPECT_TRUE(kg.reflux);
   EXPECT_TRUE(kg.laser_fire);
+  EXPECT_TRUE(kg.pick_out);
   EXPECT_DOUBLE_EQ(kg.light_level, 0.7);
   EXPECT_DOUBLE_EQ(kg.zoom, 1.5);
   EXPECT_DOUBLE_EQ(kg.laser_power_mw, 350);
