@@ -166,7 +166,7 @@ std::string describe_instruments(const PreparedCase& c) {
   ss << "tracker 0 (" << c.tracker_port_names[kToolTracker] << "): ";
   for (std::size_t i = 0; i < c.tools.size(); ++i) ss << (i ? ", " : "") << core::to_string(c.tools[i]);
   if (c.tools.empty()) ss << "none";
-  ss << " (instrument switch cycles); tracker 1 (" << c.tracker_port_names[kLightPipeTracker] << "): " << (c.light_pipe >= 0 ? "light pipe" : "none");
+  ss << " (the handpiece's tool type, else the instrument switch, picks); tracker 1 (" << c.tracker_port_names[kLightPipeTracker] << "): " << (c.light_pipe >= 0 ? "light pipe" : "none");
   return ss.str();
 }
 
