@@ -24,7 +24,7 @@ inline rig::ModelConfig light_case(const std::string& file) {
 }
 
 // A tracker's pose sample: the tip (fixture frame, mm), identity orientation, full quality.
-inline telemetry::DeviceInput tracker_sample(const core::Vec3& tip, int tool_type, int instrument_id = rig::kToolTracker) {
+inline telemetry::DeviceInput tracker_sample(const core::Vec3& tip, double tool_type, int instrument_id = rig::kToolTracker) {
   telemetry::DeviceInput in;
   in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
   in.n_values = 11;
