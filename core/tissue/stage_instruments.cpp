@@ -3,7 +3,9 @@
 // points), and their force estimates from the constraint multipliers. The broad phase that picks the
 // candidate triangles lives in core/collision (FCL); here everything is exact and allocation-free.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numbers>
 
 #include "core/common/validate.hpp"
 #include "core/tissue/contact_geometry.hpp"
@@ -24,6 +26,22 @@ constexpr double kContactSlack_mm = 0.02;
 // The most the hard projection moves any corner of a triangle, in units of the depth it removes
 // (project_contacts).
 constexpr double kMaxLever = 2.0;
+// A tip pressing tissue that lies on the wall (attached retina: its vertices are fixed) squeezes
+// the tissue's thickness against the rigid choroid and sclera. A layer much thinner than the contact
+// is an elastic foundation (Winkler; K. L. Johnson, Contact Mechanics, 1985): the pressure under
+// each point is the confined modulus E(1−ν)/((1+ν)(1−2ν)) times the local squeeze over the
+// thickness t. A spherical tip of radius R pressed δ deep touches a disc of area π·2Rδ, so the force
+// is π E_c R δ² / t — gentle at first contact, 3000 µN (the excessive-force limit) at about
+// 0.16 mm into a 0.25 mm retina with a 23 G tip. Past the whole thickness the tip is on the sclera:
+// the contact stiffness of free tissue takes over. ν = 1/3, the spring network's.
+double anchored_layer_force_un(const TissueMaterial& m, double radius_mm, double depth_mm, double rigid_un_per_mm) {
+  if (!(m.thickness_mm > 0.0) || !(depth_mm > 0.0)) return 0.0;
+  constexpr double nu = 1.0 / 3.0;
+  const double confined_pa = m.membrane_modulus_pa_mm / m.thickness_mm * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  const double squeeze = std::min(depth_mm, m.thickness_mm);
+  const double f = std::numbers::pi * confined_pa * radius_mm * squeeze * squeeze / m.thickness_mm;
+  return f + rigid_un_per_mm * std::max(0.0, depth_mm - m.thickness_mm);
+}
 }  // namespace
 
 double TissueWorld::local_pressure_on(std::uint32_t surface, std::uint32_t vertex) const {
@@ -184,6 +202,12 @@ void TissueWorld::add_point_terms(double fraction) {
     t.target = g.previous_target + fraction * (g.d.target_mm - g.previous_target);
     add_point_term(t);
   }
+  struct AnchoredPress {
+    double depth = 0.0;
+    Vec3 normal = Vec3::Zero();
+    std::uint32_t surface = 0;
+  };
+  std::array<AnchoredPress, kMaxColliders> anchored{};
   for (const ContactCandidate& c : candidates_) {
     const ColliderCapsule& cap = colliders_[c.collider];
     const Vec3 a = cap.a0 + fraction * (cap.a1 - cap.a0);
@@ -194,6 +218,14 @@ void TissueWorld::add_point_terms(double fraction) {
     const auto st = contact::closest_segment_triangle(a, b, x0, x1, x2);
     // Within reach: the triangle may move toward the capsule during the substep's sweeps.
     if (st.crossing || !(st.distance > 1e-9) || st.distance > cap.radius_mm + kContactReach_mm) continue;
+    if (s.is_fixed(tv[0]) && s.is_fixed(tv[1]) && s.is_fixed(tv[2])) {
+      // Attached retina: nothing to move, but the instrument presses into the tissue's thickness.
+      // One press per instrument part, at its deepest (every triangle under the tip sees it).
+      if (st.distance < cap.radius_mm && cap.radius_mm - st.distance > anchored[c.collider].depth) {
+        anchored[c.collider] = {cap.radius_mm - st.distance, (st.on_triangle - st.on_segment) / st.distance, c.surface};
+      }
+      continue;
+    }
     PointTerm t{};
     t.kind = PointKind::kContact;
     t.owner = c.collider;
@@ -208,6 +240,14 @@ void TissueWorld::add_point_terms(double fraction) {
     t.target = st.on_segment;
     t.offset = cap.radius_mm;
     add_point_term(t);
+  }
+  for (std::uint32_t k = 0; k < collider_count_; ++k) {
+    const AnchoredPress& p = anchored[k];
+    if (!(p.depth > 0.0)) continue;
+    const double f = anchored_layer_force_un(surfaces_[p.surface]->material(), colliders_[k].radius_mm, p.depth,
+                                             settings_.contact_stiffness_un_per_mm);
+    contact_force_[k * surfaces_.size() + p.surface] -= p.normal * (f / settings_.substeps);
+    contact_depth_[k] = std::max(contact_depth_[k], p.depth);
   }
 }
 

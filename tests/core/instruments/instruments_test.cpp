@@ -858,6 +858,50 @@ TEST(Instruments, AShaftAlongAnAnchoredRimPressesTheSheetAndFlingsNothing) {
   EXPECT_LT(stretch, 0.3);
 }
 
+// Attached retina (every vertex fixed on the wall) pressed by a 23 G tip: nothing moves, yet the tip
+// squeezes the retina's 0.25 mm against the sclera. The force grows from nothing at first touch as
+// an elastic foundation's (π E_c R δ²/t, E_c the confined modulus at ν = 1/3), so a gentle touch is
+// possible; before, the tip passed into the thickness with no force at all.
+TEST(Instruments, PressingAttachedRetinaSqueezesItsThicknessSmoothly) {
+  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+  SurfaceDescription d = sheet(4.0, 20, 0.0);
+  d.material = TissueMaterial{};  // the retina's defaults: E·t = 5000 Pa·mm, t = 0.25 mm
+  const std::uint32_t m = world.add_surface(d);
+  Surface& s = world.surface(m);
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) ASSERT_TRUE(s.set_fixed(s.vertex_id(v), true));
+  InstrumentSceneOptions o;
+  o.ports_mm = {Vec3(0, 0, 10)};
+  Simulation sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k23, 0, {}}});
+  const double r = shaft_radius_mm(Gauge::k23);
+  const double t = 0.25, e_confined = 5000.0 / t * 1.5;  // E(1−ν)/((1+ν)(1−2ν)) = 1.5 E at ν = 1/3
+  double previous = 0.0, at_50um = -1.0;
+  int touching = 0;
+  for (int i = 0; i <= 200; ++i) {  // the rounded tip from 0.02 mm above the sheet to 0.18 mm into it, 1 µm a step
+    ASSERT_TRUE(sys.set_input(0, down_to(r + 0.02 - 0.001 * i)));  // down_to places the shaft axis's end
+    ASSERT_TRUE(sys.step(kDt).tissue.ok);
+    const double f = sys.instrument(0).contact_force_un.norm();
+    double depth = 0.0;
+    for (std::uint32_t c = 0; c < TissueWorld::kMaxColliders; ++c) depth = std::max(depth, world.max_contact_depth(c));
+    if (depth > 0.0) ++touching;
+    if (depth > 0.005) {
+      const double expected = std::numbers::pi * e_confined * r * depth * depth / t;
+      EXPECT_NEAR(f, expected, 0.03 * expected + 1.0) << "depth " << depth;
+    }
+    if (depth <= 0.005) {
+      EXPECT_LT(f, 10.0) << "first touch is gentle, depth " << depth;
+    }
+    EXPECT_LT(f - previous, 100.0) << "no jump: 1 µm more press adds little force (depth " << depth << ")";
+    EXPECT_GE(f, previous - 1e-9) << "deeper presses harder";
+    if (at_50um < 0.0 && depth >= 0.05) at_50um = f;
+    previous = f;
+  }
+  EXPECT_GT(touching, 120);
+  // A gentle touch (0.05 mm into the retina) stays far below the 3000 µN excessive-force limit.
+  EXPECT_GT(at_50um, 100.0);
+  EXPECT_LT(at_50um, 600.0);
+  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) EXPECT_EQ(s.position(v), s.rest_position(v));
+}
+
 struct VitrectorOverSheet {
   TissueWorld world{GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()};
   std::uint32_t gel = 0;
