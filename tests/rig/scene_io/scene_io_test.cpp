@@ -203,7 +203,10 @@ TEST(SceneFiles, MissingFileIsAnError) {
 }
 
 // Random mutations of valid files: every outcome is a parsed description or a SceneError (or, at build
-// time, InvalidArgument); nothing crashes or throws anything else. Fixed seed, bounded time.
+// time, InvalidArgument); nothing crashes or throws anything else. Fixed seed and a fixed number of
+// mutants (a wall-clock deadline made the count depend on the machine's load: under ASan on a busy
+// machine only 81 mutants ran). Every tenth that parses is built at 2000 retina vertices: the
+// builder's checks are what is tried, not its resolution.
 TEST(SceneFuzz, MutatedFilesNeverCrash) {
   std::uint64_t state = 0x5eed;
   const auto rnd = [&](std::uint64_t n) {
@@ -213,9 +216,8 @@ TEST(SceneFuzz, MutatedFilesNeverCrash) {
   const std::vector<std::string> tokens{"=", "[", "]", "{", "}", "\"", "\n", "0", "-1", "1e308", "nan", "inf", "[[tear]]",
                                         "[[membrane]]", "[anatomy]", "x = 1", "name = \"q\"", ",", "#", "retina_vertices = 900"};
   const auto files = files_in(kScenes);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   int parsed = 0, refused = 0, built = 0;
-  for (int it = 0; it < 3000 && std::chrono::steady_clock::now() < deadline; ++it) {
+  for (int it = 0; it < 600; ++it) {
     const std::string file = kScenes + "/" + files[rnd(files.size())];
     std::string text = read(file);
     const int edits = 1 + static_cast<int>(rnd(4));
@@ -239,9 +241,10 @@ TEST(SceneFuzz, MutatedFilesNeverCrash) {
       }
     }
     try {
-      const core::SceneDescription d = scene_io::parse_scene(text, file);
+      core::SceneDescription d = scene_io::parse_scene(text, file);
       ++parsed;
-      if (d.anatomy.retina_vertices <= 25000 && it % 10 == 0) {
+      if (it % 10 == 0) {
+        d.anatomy.retina_vertices = std::min(d.anatomy.retina_vertices, 2000);
         try {
           core::BuildOptions o;
           o.settle = false;
@@ -259,8 +262,8 @@ TEST(SceneFuzz, MutatedFilesNeverCrash) {
   RecordProperty("parsed", parsed);
   RecordProperty("refused", refused);
   EXPECT_GT(refused, 0);
-  EXPECT_GT(parsed + refused, 100);
-  (void)built;
+  EXPECT_EQ(parsed + refused, 600);
+  EXPECT_GT(built, 0);
 }
 
 }  // namespace
