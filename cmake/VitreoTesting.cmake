@@ -15,7 +15,8 @@ if(VITREO_BUILD_BENCHMARKS)
 endif()
 
 function(vitreo_add_test name)
-  cmake_parse_arguments(T "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  # ENVIRONMENT: one NAME=VALUE for every test of the executable (set with the labels below).
+  cmake_parse_arguments(T "" "TIMEOUT;ENVIRONMENT" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT VITREO_BUILD_TESTS)
     return()
   endif()
@@ -33,8 +34,12 @@ function(vitreo_add_test name)
     PROPERTIES TIMEOUT ${T_TIMEOUT}
     DISCOVERY_TIMEOUT 120)
   set(_labels_file ${CMAKE_CURRENT_BINARY_DIR}/${name}_labels.cmake)
+  set(_env "")
+  if(T_ENVIRONMENT)
+    set(_env " ENVIRONMENT \"${T_ENVIRONMENT}\"")
+  endif()
   file(WRITE ${_labels_file}
-    "if(${name}_TESTS)\n  set_tests_properties(\${${name}_TESTS} PROPERTIES LABELS \"${T_LABELS}\")\nendif()\n")
+    "if(${name}_TESTS)\n  set_tests_properties(\${${name}_TESTS} PROPERTIES LABELS \"${T_LABELS}\"${_env})\nendif()\n")
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${_labels_file})
 endfunction()
 

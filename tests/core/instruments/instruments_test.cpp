@@ -816,14 +816,10 @@ TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
   }
 }
 
-// A vitrector at full vacuum over an anchored 4 mm gel sheet: its shaft along +x just above the sheet,
-// the port turned down toward it. Full suction removes a fifth of the sheet in 300 ms; the
-// guillotine's cuts around the port take more spring and triangle slots on the way than the default
-// reserve.
 // A shaft that lies on a sheet right beside its anchored rim (the vitrector sweeping along a
 // traction plane's edge held by the vitreous, or across the gel's rim at the vitreous base) presses
 // the sheet down by the little it overlaps it. Pushing a point next to a fixed corner out of the
-// shaft used to fling the free corners by depth/(barycentric weight): tens of millimetres.
+// shaft used to fling the free corners by depth/(barycentric weight), without bound.
 TEST(Instruments, AShaftAlongAnAnchoredRimPressesTheSheetAndFlingsNothing) {
   TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
   const double size = 8.0;
@@ -902,6 +898,10 @@ TEST(Instruments, PressingAttachedRetinaSqueezesItsThicknessSmoothly) {
   for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) EXPECT_EQ(s.position(v), s.rest_position(v));
 }
 
+// A vitrector at full vacuum over an anchored 4 mm gel sheet: its shaft along +x just above the sheet,
+// the port turned down toward it. Full suction removes a fifth of the sheet in 300 ms; the
+// guillotine's cuts around the port take more spring and triangle slots on the way than the default
+// reserve.
 struct VitrectorOverSheet {
   TissueWorld world{GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()};
   std::uint32_t gel = 0;
