@@ -1,4 +1,4 @@
-/* vitreo device protocol (VP), version 1.0 — freestanding C99.
+/* vitreo device protocol (VP), version 1.1 — freestanding C99.
  *
  * The same file builds for the rig's microcontrollers (Cortex-M, -ffreestanding) and for the host.
  * No heap, no libc beyond memcpy/memset, no floating-point maths beyond comparisons (so no libm).
@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define VP_PROTO_MAJOR 1u
-#define VP_PROTO_MINOR 0u
+#define VP_PROTO_MINOR 1u
 
 #define VP_HEADER_SIZE 4u   /* version, type, sequence, payload length */
 #define VP_MAX_PAYLOAD 56u  /* so a packet plus CRC fits a 64-byte USB packet / CAN FD frame */
@@ -71,7 +71,8 @@ typedef enum {
 typedef enum {
   VP_TOOL_NONE = 0, VP_TOOL_LIGHT_PIPE = 1, VP_TOOL_VITRECTOR = 2, VP_TOOL_FORCEPS = 3,
   VP_TOOL_SCISSORS = 4, VP_TOOL_LASER = 5, VP_TOOL_PICK = 6, VP_TOOL_FLUTE = 7,
-  VP_TOOL_INFUSION = 8, VP_TOOL_COUNT = 9
+  VP_TOOL_INFUSION = 8, VP_TOOL_BLADE = 9, VP_TOOL_SIDEWAYS_BLADE = 10, /* 1.1 */
+  VP_TOOL_COUNT = 11
 } vp_tool_type;
 
 typedef enum { VP_CFG_GET = 0, VP_CFG_SET = 1, VP_CFG_ACK = 2, VP_CFG_NAK = 3 } vp_config_op;

@@ -61,8 +61,8 @@ const char* to_string(GelStain s) {
 }
 
 const std::vector<std::string>& known_instruments() {
-  static const std::vector<std::string> names{"vitrector", "forceps",   "scissors", "pick",
-                                              "laser",     "light_pipe", "backflush", "infusion"};
+  static const std::vector<std::string> names{"vitrector", "forceps",   "scissors",  "pick",  "laser",
+                                              "light_pipe", "backflush", "infusion", "blade", "sideways_blade"};
   return names;
 }
 

@@ -29,7 +29,8 @@ struct FaultEvent {
 
 // Script text, one directive per line ('#' starts a comment):
 //   device tracker|pedals|eyeball     rate_hz N     serial N     loop 0|1     autostream 0|1
-//   tool N  instrument N              (tracker only)
+//   tool N  instrument N              (tracker only) tool type (PROTOCOL.md: 0 a universal handpiece,
+//                                     9 blade, ...) and tracker channel
 //   key <t_ms> <values...>            tracker: x_mm y_mm z_mm yaw_deg pitch_deg roll_deg actuation(0..1)
 //                                     pedals:  axis0 axis1 switches           (axes 0..1)
 //                                     eyeball: yaw_deg pitch_deg depth0_mm depth1_mm depth2_mm (0 = no instrument)

@@ -9,7 +9,7 @@ meaning given in vectors.txt and encodes that meaning back to the same bytes.
 import math
 import struct
 
-MAJOR, MINOR = 1, 0
+MAJOR, MINOR = 1, 1
 T = dict(heartbeat=0x01, device_info=0x02, time_sync=0x03, status=0x04, config=0x05,
          calib_request=0x06, calib_result=0x07, pose_sample=0x10, pedal_state=0x11, eyeball_state=0x12)
 PRIO = dict(time_sync=1, pose_sample=2, pedal_state=2, eyeball_state=2, status=3, config=5,
@@ -206,6 +206,14 @@ add('bad_crc.serial.bin', 'serial', serial(packet('pose_sample', 201, pose), cor
 add('major2.serial.bin', 'serial', serial(packet('pose_sample', 202, pose, major=2)), 'error VERSION')
 add('unknown_type.serial.bin', 'serial', serial(packet('pose_sample', 203, pose, type_override=0x7E)),
     'error UNKNOWN_TYPE')
+# 1.1's tool types: the blade and the sideways blade; the first code past them is out of range.
+blade = dict(pose, tool_type=9)
+add('blade_pose.serial.bin', 'serial', serial(packet('pose_sample', 208, blade)), describe('pose_sample', 208, blade))
+sideways = dict(pose, tool_type=10)
+add('sideways_blade_pose.usb.bin', 'usb', usb(packet('pose_sample', 209, sideways)), describe('pose_sample', 209, sideways))
+add('sideways_blade_pose.canfd.bin', 'can', canfd('pose_sample', packet('pose_sample', 209, sideways), 17),
+    describe('pose_sample', 209, sideways))
+add('tool_type_11.usb.bin', 'usb', usb(packet('pose_sample', 210, dict(pose, tool_type=11))), 'error RANGE')
 nan = dict(pose, tip_mm=[float('nan'), 0.0, 0.0])
 add('nan_tip.serial.bin', 'serial', serial(packet('pose_sample', 204, nan)), 'error RANGE')
 far = dict(pose, tip_mm=[f32(900.0), 0.0, 0.0])

@@ -186,7 +186,7 @@ int main(int argc, char** argv) {
   auto* stdin_opt = app.add_flag("--commands-from-stdin", commands_from_stdin,
                "read operator commands from stdin even when it is not a terminal (a pipe, a script); when it is a\n"
                "terminal they are read anyway: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X,\n"
-               "pan X Y, focus F, flat, wide, invert");
+               "pan X Y, focus F, flat, wide, invert, laser_power MW, laser_duration MS");
   std::vector<std::string> displays;
   auto* display_opt = app.add_option("--display", displays,
                  "show the frames on a rig display through KMS: CARD[:CONNECTOR[:sbs|left|right]], e.g.\n"
@@ -219,6 +219,7 @@ int main(int argc, char** argv) {
       vitreo::rig::RigFile rig = vitreo::rig::read_rig_file(rig_path);
       devices = std::move(rig.devices);
       if (rig.pedals) model.pedals = *rig.pedals;
+      if (rig.laser) model.laser = *rig.laser;
       if (calibration_path.empty()) calibration_path = rig.calibration_path;
       if (calibration_max_age_days < 0.0 && rig.calibration_max_age_days) calibration_max_age_days = *rig.calibration_max_age_days;
       spdlog::info("rig {}: {} device(s){}", rig_path, devices.size(), rig.name.empty() ? "" : " — " + rig.name);
@@ -303,7 +304,7 @@ int main(int argc, char** argv) {
     config.render = render;
     if (commands_from_stdin || ::isatty(STDIN_FILENO)) {
       config.command_fd = STDIN_FILENO;
-      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X pan X Y focus F flat wide invert — one per line\n");
+      std::printf("operator commands: n(ext) p(rev) pause resume r(eset) s NAME w(ireframe) l(abels) z X pan X Y focus F flat wide invert laser_power MW laser_duration MS — one per line\n");
       std::fflush(stdout);
     }
     config.eye_width = eye_width;
@@ -411,6 +412,10 @@ int main(int argc, char** argv) {
     std::printf("  script           %s%s%s\n", script.file.empty() ? "none (idle)" : script.file.c_str(),
                 script.file.empty() ? "" : (" (" + script.kind + ")").c_str(), script.summary.empty() ? "" : (": " + script.summary).c_str());
     std::printf("  calibration      %s\n", calibration_in_force.c_str());
+    std::printf("  laser            %g mW × %g ms per shot", s.laser_at_start.power_mw, s.laser_at_start.duration_ms);
+    if (s.laser_at_end.power_mw != s.laser_at_start.power_mw || s.laser_at_end.duration_ms != s.laser_at_start.duration_ms)
+      std::printf(", %g mW × %g ms at the end (operator commands)", s.laser_at_end.power_mw, s.laser_at_end.duration_ms);
+    std::printf("\n");
     for (const auto& line : s.cases_loaded) std::printf("  case loaded      %s\n", line.c_str());
     std::printf("  simulated        %.3f s in %llu steps (%s)\n", s.simulated_s, static_cast<unsigned long long>(s.steps),
                 s.stop_reason == "duration reached" ? "the whole duration" : ("stopped early by " + s.stop_reason).c_str());

@@ -39,6 +39,7 @@ bool PedalMapper::apply(const PedalReading& raw) {
     c_.cut_rate_cpm = c_.vacuum_mmhg > 0.0 ? m_.cut_rate_min_cpm + travel * (m_.cut_rate_max_cpm - m_.cut_rate_min_cpm) : 0.0;
     c_.reflux = bit(r.switches, m_.reflux_switch);
     c_.laser_fire = bit(r.switches, m_.laser_switch);
+    c_.pick_out = bit(r.switches, m_.pick_switch);
     if (bit(r.switches, m_.instrument_switch) && !bit(last_switches_[0], m_.instrument_switch)) ++c_.instrument_changes;
     if (bit(r.switches, m_.air_switch) && !bit(last_switches_[0], m_.air_switch)) c_.air_infusion = !c_.air_infusion;
     last_switches_[0] = r.switches;
@@ -93,6 +94,7 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
       {"laser_switch", {nullptr, &m.laser_switch, -1, 15}},
       {"instrument_switch", {nullptr, &m.instrument_switch, -1, 15}},
       {"air_switch", {nullptr, &m.air_switch, -1, 15}},
+      {"pick_switch", {nullptr, &m.pick_switch, -1, 15}},
       {"microscope_pedal_id", {nullptr, &m.microscope_pedal_id, 0, 255}},
       {"zoom_axis", {nullptr, &m.zoom_axis, -1, 3}},
       {"focus_axis", {nullptr, &m.focus_axis, -1, 3}},
@@ -144,7 +146,7 @@ PedalMapping parse_pedal_mapping(const std::string& toml_text, const std::string
     }
   };
   distinct("switch", {{"reflux_switch", m.reflux_switch}, {"laser_switch", m.laser_switch},
-                      {"instrument_switch", m.instrument_switch}, {"air_switch", m.air_switch}});
+                      {"instrument_switch", m.instrument_switch}, {"air_switch", m.air_switch}, {"pick_switch", m.pick_switch}});
   distinct("axis", {{"vacuum_axis", m.vacuum_axis}, {"cut_rate_axis", m.cut_rate_axis}});
   distinct("switch", {{"light_up_switch", m.light_up_switch}, {"light_down_switch", m.light_down_switch}});
   distinct("axis", {{"zoom_axis", m.zoom_axis}, {"focus_axis", m.focus_axis}});

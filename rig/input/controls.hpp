@@ -2,7 +2,8 @@
 // Foot pedals → surgical controls, from a mapping configuration.
 //
 // The vitrectomy pedal's travel sets vacuum (and, on dual-linear pedals, its side travel the cut
-// rate); its switches fire the laser, reflux, and change instrument. The microscope pedal sets zoom,
+// rate); its switches fire the laser, reflux, change instrument, switch fluid–air and put the light
+// pipe's pick out. The microscope pedal sets zoom,
 // focus, the X–Y joystick and light. Which axis or switch does what is configuration, since rigs differ
 // (rig/config/default-rig.toml).
 #include <cstdint>
@@ -35,6 +36,7 @@ struct PedalMapping {
   int laser_switch = 1;
   int instrument_switch = 2;
   int air_switch = 3;  // fluid–air exchange: each press switches the infusion between fluid and air
+  int pick_switch = 4;  // the light pipe's pick (a lighted pick) is out while held; not the laser's switch
 
   int microscope_pedal_id = 1;
   int zoom_axis = 0;
@@ -57,6 +59,7 @@ struct SurgicalControls {
   double cut_rate_cpm = 0.0;
   bool reflux = false;
   bool laser_fire = false;
+  bool pick_out = false;  // the light pipe's pick, held out by pick_switch
   std::uint32_t instrument_changes = 0;  // rising edges of the instrument switch so far
   bool air_infusion = false;             // the infusion runs air (fluid–air exchange), toggled by air_switch
   double zoom = 1.0;

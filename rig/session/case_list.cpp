@@ -1,6 +1,7 @@
 // The session's case list as one text (a recording's header carries it) and back: see
 // simulation_model.hpp (encode_case_list / decode_case_list) and rig/telemetry/RECORDING.md.
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string_view>
@@ -26,6 +27,15 @@ std::string encode_case_list(const ModelConfig& c) {
     out += t.text;
     out += t.library_text;
   }
+  // The laser's start settings, only where the rig file changed them (recordings without them are
+  // unchanged); %.17g gives back the same double.
+  auto exact = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  if (c.laser.power_mw != LaserSettings{}.power_mw) out += "laser_power_mw " + exact(c.laser.power_mw) + "\n";
+  if (c.laser.duration_ms != LaserSettings{}.duration_ms) out += "laser_duration_ms " + exact(c.laser.duration_ms) + "\n";
   // The calibration in force, only when there is one (recordings without it are unchanged).
   if (!c.calibration_text.empty()) out += "calibration " + std::to_string(c.calibration_text.size()) + "\n" + c.calibration_text;
   return out;
@@ -38,6 +48,16 @@ bool parse_count(std::string_view token, long long lo, long long hi, long long& 
   long long v = 0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
   if (ec != std::errc() || end != token.data() + token.size() || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+// A finite decimal number, the whole token.
+bool parse_number(std::string_view token, double& out) {
+  if (token.empty() || token.size() > 40) return false;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
+  if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(v)) return false;
   out = v;
   return true;
 }
@@ -74,6 +94,7 @@ void decode_case_list(const std::string& text, ModelConfig& config) {
   out.calibration_text.clear();
   out.eye_zero = core::Quat::Identity();
   out.pedals.axis_ranges.clear();
+  out.laser = {};  // the console's defaults unless the recording says otherwise
   long long first_case = 0;
   constexpr long long kMaxCases = 4096;
   while (at < text.size()) {
@@ -106,6 +127,12 @@ void decode_case_list(const std::string& text, ModelConfig& config) {
       }
     } else if (w.size() == 2 && w[0] == "first_case") {
       if (!parse_count(w[1], 0, kMaxCases - 1, first_case)) fail("first_case out of range in '" + shown + "'");
+    } else if (w.size() == 2 && w[0] == "laser_power_mw") {
+      if (!parse_number(w[1], out.laser.power_mw) || !laser_power_in_range(out.laser.power_mw))
+        fail("laser_power_mw out of range in '" + shown + "'");
+    } else if (w.size() == 2 && w[0] == "laser_duration_ms") {
+      if (!parse_number(w[1], out.laser.duration_ms) || !laser_duration_in_range(out.laser.duration_ms))
+        fail("laser_duration_ms out of range in '" + shown + "'");
     } else if (w.size() == 2 && w[0] == "retina_vertices") {
       if (!parse_count(w[1], 0, 2'000'000, a)) fail("retina_vertices out of range in '" + shown + "'");
       out.load.retina_vertices = static_cast<int>(a);

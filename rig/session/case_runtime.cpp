@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/common/status.hpp"
+#include "firmware-protocol/vp.h"
 
 namespace vitreo::rig {
 
@@ -61,8 +62,26 @@ bool instrument_kind(const std::string& name, core::InstrumentKind& out) {
   else if (name == "laser") out = K::kEndolaser;
   else if (name == "light_pipe") out = K::kLightPipe;
   else if (name == "backflush") out = K::kDrainageNeedle;  // soft-tip flute needle
+  else if (name == "blade") out = K::kBlade;
+  else if (name == "sideways_blade") out = K::kSidewaysBlade;
   else return false;                                      // "infusion": a cannula, not held
   return true;
+}
+
+bool instrument_kind_of_tool_type(int tool_type, core::InstrumentKind& out) {
+  using K = core::InstrumentKind;
+  switch (tool_type) {
+    case VP_TOOL_LIGHT_PIPE: out = K::kLightPipe; return true;
+    case VP_TOOL_VITRECTOR: out = K::kVitrector; return true;
+    case VP_TOOL_FORCEPS: out = K::kForceps; return true;
+    case VP_TOOL_SCISSORS: out = K::kScissors; return true;
+    case VP_TOOL_LASER: out = K::kEndolaser; return true;
+    case VP_TOOL_PICK: out = K::kPick; return true;
+    case VP_TOOL_FLUTE: out = K::kDrainageNeedle; return true;  // the scene files' "backflush"
+    case VP_TOOL_BLADE: out = K::kBlade; return true;
+    case VP_TOOL_SIDEWAYS_BLADE: out = K::kSidewaysBlade; return true;
+    default: return false;  // 0: a universal handpiece names no tool; 8: the infusion is not held
+  }
 }
 
 std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>& cases, int index,
@@ -147,7 +166,7 @@ std::string describe_instruments(const PreparedCase& c) {
   ss << "tracker 0 (" << c.tracker_port_names[kToolTracker] << "): ";
   for (std::size_t i = 0; i < c.tools.size(); ++i) ss << (i ? ", " : "") << core::to_string(c.tools[i]);
   if (c.tools.empty()) ss << "none";
-  ss << " (instrument switch cycles); tracker 1 (" << c.tracker_port_names[kLightPipeTracker] << "): " << (c.light_pipe >= 0 ? "light pipe" : "none");
+  ss << " (the handpiece's tool type, else the instrument switch, picks); tracker 1 (" << c.tracker_port_names[kLightPipeTracker] << "): " << (c.light_pipe >= 0 ? "light pipe" : "none");
   return ss.str();
 }
 

@@ -63,6 +63,11 @@ struct PreparedCase {
 // instruments ("infusion").
 bool instrument_kind(const std::string& name, core::InstrumentKind& out);
 
+// The instrument kind a tracker's tool type names (firmware-protocol/PROTOCOL.md, POSE_SAMPLE); false
+// for 0 (a universal handpiece that names no tool), 8 (the infusion is no held instrument) and codes
+// past the last.
+bool instrument_kind_of_tool_type(int tool_type, core::InstrumentKind& out);
+
 // Loads case `index` of `cases` and builds its instruments. Throws like scene_io::load_case.
 std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>& cases, int index,
                                            const scene_io::CaseLoadOptions& options);

@@ -48,6 +48,9 @@ telemetry::DeviceInput encode_sample(const drivers::Sample& sample, std::int32_t
 bool decode_tracker(const telemetry::DeviceInput& in, DecodedTracker& out) {
   if (in.device_kind != static_cast<std::int8_t>(InputKind::Tracker) || in.n_values < 11) return false;
   const double* v = in.values;
+  // The instrument id and tool type are bytes on the wire (a recording could say anything else, and
+  // converting a double beyond int's range is undefined).
+  if (!(v[9] >= 0.0 && v[9] <= 255.0 && v[10] >= 0.0 && v[10] <= 255.0)) return false;
   out.pose.tip_mm = core::Vec3(v[0], v[1], v[2]);
   out.pose.orientation = core::Quat(v[3], v[4], v[5], v[6]);
   out.pose.actuation = v[7];

@@ -32,7 +32,8 @@ struct DecodedEyeball {
   bool inserted[3] = {};
   double depth_mm[3] = {};
 };
-// Each returns false for a record of another kind or with too few values.
+// Each returns false for a record of another kind or with too few values (a tracker's also for an
+// instrument id or tool type that is no byte).
 bool decode_tracker(const telemetry::DeviceInput& in, DecodedTracker& out);
 bool decode_pedals(const telemetry::DeviceInput& in, PedalReading& out);
 bool decode_eyeball(const telemetry::DeviceInput& in, DecodedEyeball& out);

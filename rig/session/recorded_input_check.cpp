@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "rig/session/device_inputs.hpp"
+#include "rig/telemetry/commands.hpp"
 #include "rig/session/simulation_model.hpp"
 
 namespace vitreo::rig {
@@ -28,7 +29,7 @@ const char* check_recorded_input(const telemetry::DeviceInput& in) noexcept {
         return "a session-end marker whose step count is not its own step + 1";
       return nullptr;
     case kCommandKind:
-      if (in.n_values < 2 || !integral(in.values[0], 1, 9)) return "an operator command with an unknown code";
+      if (in.n_values < 2 || !integral(in.values[0], 1, telemetry::kLastCommandCode)) return "an operator command with an unknown code";
       return nullptr;
     case kCaseKind:
       if (in.n_values < 1 || !integral(in.values[0], 0, 4096)) return "a case index out of range";

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <spdlog/fmt/fmt.h>
+
 #include "drivers/device_uri.hpp"
 
 namespace vitreo::rig {
@@ -47,8 +49,8 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
     throw std::runtime_error(origin + ":" + std::to_string(line_of(n)) + ": " + key + ": " + why);
   };
   for (const auto& [k, v] : root) {
-    if (k != "rig" && k != "device" && k != "pedals" && k != "calibration")
-      fail(v, std::string(k.str()), "unknown key (rig, device, pedals, calibration)");
+    if (k != "rig" && k != "device" && k != "pedals" && k != "laser" && k != "calibration")
+      fail(v, std::string(k.str()), "unknown key (rig, device, pedals, laser, calibration)");
   }
   RigFile out;
   const toml::table* rig = root["rig"].as_table();
@@ -170,6 +172,29 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
     out.devices.push_back(std::move(spec));
   }
   if (root["pedals"]) out.pedals = parse_pedal_mapping(text, origin);
+  if (const toml::node* l = root.get("laser")) {
+    if (!l->is_table()) fail(*l, "laser", "must be a table (power_mw, duration_ms)");
+    const telemetry::CommandLimits limits;  // the operator commands' ranges
+    LaserSettings laser;
+    for (const auto& [k, v] : *l->as_table()) {
+      const std::string key = "laser." + std::string(k.str());
+      const std::optional<double> x = v.is_integer() ? std::optional<double>(static_cast<double>(*v.value<std::int64_t>()))
+                                      : v.is_floating_point() ? v.value<double>() : std::nullopt;
+      if (k == "power_mw") {
+        if (!x || !laser_power_in_range(*x, limits))
+          fail(v, key, fmt::format("must be a power in [{:g}, {:g}] mW", limits.laser_power_min_mw, limits.laser_power_max_mw));
+        laser.power_mw = *x;
+      } else if (k == "duration_ms") {
+        if (!x || !laser_duration_in_range(*x, limits))
+          fail(v, key, fmt::format("must be a pulse duration in [{:g}, {:g}] ms (one pulse per shot: no continuous mode)",
+                                   limits.laser_duration_min_ms, limits.laser_duration_max_ms));
+        laser.duration_ms = *x;
+      } else {
+        fail(v, key, "unknown key (power_mw, duration_ms)");
+      }
+    }
+    out.laser = laser;
+  }
   if (const toml::node* c = root.get("calibration")) {
     if (!c->is_table()) fail(*c, "calibration", "must be a table (file, max_age_days)");
     for (const auto& [k, v] : *c->as_table()) {

@@ -1,7 +1,7 @@
 #pragma once
 // A rig file (rig/config/*.toml): which devices this rig has, where each one is (a URI,
 // drivers/device_uri.hpp), what it is (its role and, optionally, its serial number) and what it
-// does (the instrument a tracker carries), plus the rig's pedal mapping. `vitreo --rig FILE`.
+// does (the instrument a tracker carries), plus the rig's pedal mapping and laser settings. `vitreo --rig FILE`.
 //
 //   [rig]
 //   version = 1                      # this format's version; another one is refused
@@ -20,6 +20,10 @@
 //
 //   [pedals]                         # optional: the pedal mapping (rig/input/controls.hpp)
 //
+//   [laser]                          # optional: the endolaser's settings at the start (rig/session/laser_settings.hpp)
+//   power_mw = 200                   # 50..2000 mW (default 200); operator command laser_power MW
+//   duration_ms = 100                # pulse per shot, 10..2000 ms (default 100); laser_duration MS
+//
 //   [calibration]                    # optional: the sensor calibration in force (vitreo-calibrate)
 //   file = "bench2.calibration.toml" # relative to the rig file; `vitreo --calibration` overrides it
 //   max_age_days = 30                # optional: warn when the calibration is older (default 30)
@@ -32,6 +36,7 @@
 #include <vector>
 
 #include "rig/input/controls.hpp"
+#include "rig/session/laser_settings.hpp"
 
 namespace vitreo::rig {
 
@@ -57,6 +62,7 @@ struct RigFile {
   std::string name;
   std::vector<DeviceSpec> devices;
   std::optional<PedalMapping> pedals;
+  std::optional<LaserSettings> laser;
   std::string calibration_path;              // empty: none (resolved against the rig file's folder)
   std::optional<double> calibration_max_age_days;
 };

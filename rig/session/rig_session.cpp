@@ -263,6 +263,7 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.case_file = config.model.cases[static_cast<std::size_t>(config.model.first_case)].file_name;
   summary.case_from_cache = first->from_cache;
   summary.instruments = describe_instruments(*first);
+  summary.laser_at_start = config.model.laser;
   SimulationModel model(config.model, std::move(first));
 
   telemetry::TelemetryPublisher publisher(telemetry::PublisherConfig{config.lcm_url, 4096});
@@ -440,8 +441,11 @@ SessionSummary run_session(const SessionConfig& config) {
       ctl.cut_rate_cpm = c.cut_rate_cpm;
       ctl.reflux = c.reflux;
       ctl.laser_fire = c.laser_fire;
+      ctl.pick_out = c.pick_out;
       ctl.light_level = c.light_level;
       ctl.zoom = c.zoom;
+      ctl.laser_power_mw = model.laser().power_mw;
+      ctl.laser_duration_ms = model.laser().duration_ms;
       physics_out.push(ctl);
     }
     if (renderer && (k % view_every == 0 || last)) {
@@ -549,6 +553,7 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.telemetry_published = publisher.published();
   summary.telemetry_dropped = publisher.dropped();
   summary.state_hash = model.state_hash();
+  summary.laser_at_end = model.laser();
   if (lockstep) {
     const LockstepStats ls = hub.lockstep_stats();
     char line[256];

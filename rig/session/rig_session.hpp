@@ -72,6 +72,7 @@ struct SessionSummary {
   std::vector<std::string> cases_loaded;         // every switch and reset, "step N: name"
   std::vector<std::string> snapshots;            // files written by "save snapshot"
   std::uint64_t grasps = 0, burns = 0;           // instrument events of note
+  LaserSettings laser_at_start, laser_at_end;    // the endolaser's settings (rig file, then commands)
   std::uint64_t steps = 0;
   double simulated_s = 0.0;
   runtime::LoopStats loop;

@@ -15,7 +15,7 @@ SimulationModel::SimulationModel(const ModelConfig& config)
     : SimulationModel(config, prepare_case(config.cases, config.first_case, config.load)) {}
 
 SimulationModel::SimulationModel(const ModelConfig& config, std::unique_ptr<PreparedCase> first)
-    : config_(config), pedals_(config.pedals) {
+    : config_(config), pedals_(config.pedals), laser_(config.laser) {
   if (!first) throw std::invalid_argument("SimulationModel: no case");
   install(std::move(first));
   case_loads_ = 0;  // the first case is the start, not a switch
@@ -43,6 +43,13 @@ void SimulationModel::install(std::unique_ptr<PreparedCase> c) {
 int SimulationModel::selected_tool() const {
   const auto n = case_->tools.size();
   if (n == 0) return -1;
+  // A handpiece that names its tool (the tracker's tool type) puts that tool in the working hand
+  // when the case offers it: a blade cannot be switched into forceps. A universal handpiece (tool
+  // type 0), or one naming a tool the case lacks, leaves the choice to the instrument switch.
+  if (core::InstrumentKind named; instrument_kind_of_tool_type(instruments_[kToolTracker].tool_type, named)) {
+    const auto it = std::find(case_->tools.begin(), case_->tools.end(), named);
+    if (it != case_->tools.end()) return static_cast<int>(it - case_->tools.begin());
+  }
   return static_cast<int>(pedals_.controls().instrument_changes % n);
 }
 
@@ -67,6 +74,7 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       ok = true;
     }
   } else if (in.device_kind == kCommandKind && in.n_values >= 2) {
+    ok = true;
     // Codes follow telemetry::CommandCode. Case changes, reset and snapshots are carried out by the
     // session (a case is loaded off the physics thread; its arrival is a kCaseKind input).
     switch (static_cast<int>(in.values[0])) {
@@ -81,9 +89,11 @@ bool SimulationModel::apply(const telemetry::DeviceInput& in) {
       case 12: flat_shading_ = !flat_shading_; break;
       case 13: microscope_.toggle_wide_angle(); break;
       case 14: microscope_.toggle_reinverter(); break;
+      // The laser's settings, held to the commands' ranges here too (a recording could say anything).
+      case 15: ok = laser_power_in_range(in.values[1]); if (ok) laser_.power_mw = in.values[1]; break;
+      case 16: ok = laser_duration_in_range(in.values[1]); if (ok) laser_.duration_ms = in.values[1]; break;
       default: break;
     }
-    ok = true;
   } else if (in.device_kind == kLinkKind && in.n_values >= 1) {
     // Which instrument a tracker link carries is its channel; the pedals' and the fixture's links
     // freeze no instrument (values[1]: the device's type, 1 a tracker; absent in older recordings).
@@ -170,9 +180,11 @@ core::StepReport SimulationModel::step() {
     }
     in.pedal = std::clamp(vacuum, 0.0, 1.0);
     in.cut_rate_cpm = c.cut_rate_cpm;  // the vitrector's cutter, from the pedal (controls.hpp)
-    // The laser switch fires the tool in the working hand, nothing else (the light pipe's pick used
-    // to stick out at every shot).
-    in.trigger = static_cast<int>(i) == tool && c.laser_fire;
+    // The laser switch fires the tool in the working hand; the light pipe's pick has its own switch
+    // (it used to stick out at every shot, then not at all).
+    in.trigger = static_cast<int>(i) == case_->light_pipe ? c.pick_out : static_cast<int>(i) == tool && c.laser_fire;
+    in.laser_power_mw = laser_.power_mw;  // the console's settings: each shot one pulse of these
+    in.laser_duration_s = 1e-3 * laser_.duration_ms;
     in.light_power_mw = 5.0 + 10.0 * c.light_level;
     (void)sys.set_input(i, in);  // refused input (non-finite) leaves the last one in place
   }
@@ -197,6 +209,7 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_u64(refused_);
   for (const auto& slot : instruments_) {
     h.add_u64((slot.present ? 1u : 0u) | (slot.frozen ? 2u : 0u) | (slot.pose.inserted ? 4u : 0u));
+    h.add_u64(static_cast<std::uint64_t>(slot.tool_type));  // it picks the working hand's tool
     h.add_vec3(slot.pose.tip_mm);
     h.add_vec3(slot.pose.axis);
     h.add_double(slot.pose.roll_rad);
@@ -212,6 +225,9 @@ std::uint64_t SimulationModel::state_hash() const {
   h.add_double(c.light_level);
   h.add_u64(c.instrument_changes);
   h.add_u64(c.air_infusion ? 1u : 0u);
+  h.add_u64((c.laser_fire ? 1u : 0u) | (c.pick_out ? 2u : 0u) | (c.reflux ? 4u : 0u));
+  h.add_double(laser_.power_mw);
+  h.add_double(laser_.duration_ms);
   h.add_double(eye_rotation_.w());
   h.add_double(eye_rotation_.x());
   h.add_double(eye_rotation_.y());

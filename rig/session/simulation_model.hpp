@@ -19,6 +19,7 @@
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/session/case_runtime.hpp"
 #include "rig/session/device_inputs.hpp"
+#include "rig/session/laser_settings.hpp"
 
 namespace vitreo::rig {
 
@@ -30,7 +31,8 @@ enum class LinkInput : int { Up = 1, Lost = 2, Stuck = 3 };
 // The session's end, recorded at its last step (values[0] = steps run) so a replay knows its length.
 inline constexpr std::int8_t kSessionEndKind = 5;
 // An accepted operator command (values[0] = telemetry::CommandCode, values[1] = its value): pause,
-// reset or zoom change the session, so they are recorded and replayed like device inputs.
+// reset, zoom or the laser's power change the session, so they are recorded and replayed like
+// device inputs.
 inline constexpr std::int8_t kCommandKind = 6;
 // A case (re)loaded at this step (values[0] = index in the case list): next/previous case and reset
 // take effect when the loader thread has the case ready, so the step they land on is recorded.
@@ -56,6 +58,8 @@ struct ModelConfig {
   core::Quat eye_zero = core::Quat::Identity();  // the fixture's reading with the eye at rest
   std::string calibration_text;
   core::MicroscopeSettings microscope;
+  // The endolaser's settings at the start (the rig file's [laser]); commands change them later.
+  LaserSettings laser;
 };
 
 // The case list and overrides as one text (stored in a recording's header), and back. decode throws
@@ -98,6 +102,8 @@ class SimulationModel {
   bool labels() const { return labels_; }
   bool flat_shading() const { return flat_shading_; }
   const core::Microscope& microscope() const { return microscope_; }
+  // The endolaser's power and pulse duration now: a console setting, kept across case changes.
+  const LaserSettings& laser() const { return laser_; }
   std::uint64_t resets() const { return resets_; }
 
   core::TissueWorld& world() { return case_->scene->world; }
@@ -113,7 +119,8 @@ class SimulationModel {
   int case_count() const { return static_cast<int>(config_.cases.size()); }
   const ModelConfig& config() const { return config_; }
   std::uint64_t case_loads() const { return case_loads_; }
-  // The hand-held tool tracker 0 drives now (index into current_case().tools; -1: none).
+  // The hand-held tool tracker 0 drives now (index into current_case().tools; -1: none): the tool
+  // its handpiece names (tool type) when the case offers it, else the instrument switch's choice.
   int selected_tool() const;
   const SurgicalControls& controls() const { return pedals_.controls(); }
   const std::array<InstrumentSlot, 4>& instruments() const { return instruments_; }
@@ -137,6 +144,7 @@ class SimulationModel {
   bool paused_ = false;
   bool wireframe_ = false, labels_ = true, flat_shading_ = false;
   core::Microscope microscope_{core::MicroscopeSettings{}, core::Vec2::Zero()};
+  LaserSettings laser_;
   std::uint64_t applied_ = 0, refused_ = 0, steps_ = 0, resets_ = 0;
 };
 

@@ -11,6 +11,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "firmware-protocol/vp.h"
 #include "rig/files/read_text_file.hpp"
 #include "rig/files/toml_guard.hpp"
 
@@ -169,7 +170,8 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.laser = w.boolean("laser");
         p.reflux = w.boolean("reflux");
         p.air = w.boolean("air");
-        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air");
+        p.pick = w.boolean("pick");
+        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick");
         h.waypoints.push_back(std::move(p));
       }
       r.refuse_unknown("tracker, speed_mm_s, waypoint");
@@ -395,6 +397,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     std::optional<double> vacuum, cut_rate;
     std::optional<bool> laser, reflux, air;
     int presses = 0;  // instrument switch
+    std::optional<bool> pick;
     int line;
   };
   std::vector<PedalChange> changes;
@@ -434,7 +437,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       const ScriptWaypoint& w = hand.waypoints[i];
       const std::string key = hand_key + ".waypoint[" + std::to_string(i) + "]";
       if (w.at_s && *w.at_s > t) add_segment(pos, jaws, *w.at_s - t, std::nullopt);  // wait in place
-      PedalChange ch{t, w.vacuum, w.cut_rate, w.laser, w.reflux, w.air, 0, w.line};
+      PedalChange ch{t, w.vacuum, w.cut_rate, w.laser, w.reflux, w.air, 0, w.pick, w.line};
       if (w.tool) {
         const auto it = std::find(tools.begin(), tools.end(), *w.tool);
         if (it == tools.end()) landmarks.fail(w.tool_line, key + ".tool", "the case offers no " + *w.tool + " to the working hand");
@@ -444,7 +447,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
         // a press takes 100 ms (down, up) and the hand waits for the switch
         if (ch.presses > 0) add_segment(pos, jaws, 0.1 * ch.presses + 0.05, std::nullopt);
       }
-      if (ch.vacuum || ch.cut_rate || ch.laser || ch.reflux || ch.air || ch.presses) changes.push_back(ch);
+      if (ch.vacuum || ch.cut_rate || ch.laser || ch.reflux || ch.air || ch.pick || ch.presses) changes.push_back(ch);
       Landmark l = landmarks.resolve(w.to, hand.tracker, w.to_line, key + ".to");
       Vec3 tangent_to_port = port.position_mm - l.at;
       tangent_to_port -= tangent_to_port.dot(l.inward) * l.inward;
@@ -478,14 +481,18 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       if (w.hold_s > 0.0) add_segment(pos, jaws, w.hold_s / script.speed_scale, std::nullopt);
     }
     const std::string name = "tracker-" + std::to_string(hand.tracker);
-    std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool 3\ninstrument " +
+    // The working hand holds a universal handpiece (tool type 0): the script's `tool =` picks the
+    // tool with instrument-switch presses. The other hand's handpiece is the light pipe.
+    const int tool_type = hand.tracker == kToolTracker ? VP_TOOL_NONE : VP_TOOL_LIGHT_PIPE;
+    std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool " +
+                         std::to_string(tool_type) + "\ninstrument " +
                          std::to_string(hand.tracker) + "\nloop 0\nseed " + std::to_string(script.seed + static_cast<std::uint64_t>(hand.tracker)) + "\n";
     out.device_scripts[name] = header + keys;
   }
 
   if (!out.device_scripts.count("tracker-0")) {  // no working hand scripted: it stays outside the eye
     const Port& port = c.tracker_ports[kToolTracker];
-    out.device_scripts["tracker-0"] = "device tracker\nrate_hz 1000\nserial 1001\ntool 3\ninstrument 0\nloop 0\nseed " +
+    out.device_scripts["tracker-0"] = "device tracker\nrate_hz 1000\nserial 1001\ntool 0\ninstrument 0\nloop 0\nseed " +
                                       std::to_string(script.seed) + "\n" + tracker_key(0, port.position_mm + 2.0 * port.outward, 0);
   }
 
@@ -511,6 +518,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     if (ch.cut_rate) next.cut_rate = *ch.cut_rate;
     if (ch.laser) next.switches = *ch.laser ? next.switches | bit(pedals.laser_switch) : next.switches & ~bit(pedals.laser_switch);
     if (ch.reflux) next.switches = *ch.reflux ? next.switches | bit(pedals.reflux_switch) : next.switches & ~bit(pedals.reflux_switch);
+    if (ch.pick) next.switches = *ch.pick ? next.switches | bit(pedals.pick_switch) : next.switches & ~bit(pedals.pick_switch);
     for (int i = 0; i < ch.presses; ++i) {
       pedal_key(t_ms + 1.0, PedalState{st.vacuum, st.cut_rate, st.switches | bit(pedals.instrument_switch)});
       pedal_key(t_ms + 50.0, PedalState{st.vacuum, st.cut_rate, st.switches | bit(pedals.instrument_switch)});

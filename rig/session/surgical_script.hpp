@@ -49,6 +49,7 @@ struct ScriptWaypoint {
   std::optional<double> vacuum;    // 0..1 of the vitrectomy pedal's travel
   std::optional<double> cut_rate;  // 0..1 of the side travel
   std::optional<bool> laser, reflux, air;
+  std::optional<bool> pick;  // the light pipe's pick out (its own pedal switch)
 };
 
 struct ScriptHand {

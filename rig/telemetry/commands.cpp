@@ -29,6 +29,8 @@ const char* command_name(std::int8_t code) noexcept {
     case CommandCode::ToggleShading: return "toggle_shading";
     case CommandCode::ToggleWideAngle: return "toggle_wide_angle";
     case CommandCode::ToggleReinverter: return "toggle_reinverter";
+    case CommandCode::LaserPower: return "laser_power";
+    case CommandCode::LaserDuration: return "laser_duration";
   }
   return "unknown";
 }
@@ -114,6 +116,17 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
       c.value = v;
       out.ok = true;
     }
+  } else if (word == "laser_power" || word == "laser_duration") {
+    char* end = nullptr;
+    const double v = arg.empty() ? 0.0 : std::strtod(arg.c_str(), &end);
+    if (arg.empty() || end != arg.c_str() + arg.size() || !std::isfinite(v)) {
+      out.error = word == "laser_power" ? "laser_power needs a finite number (mW), e.g. 'laser_power 250'"
+                                        : "laser_duration needs a finite number (ms), e.g. 'laser_duration 150'";
+    } else {
+      c.command = static_cast<std::int8_t>(word == "laser_power" ? CommandCode::LaserPower : CommandCode::LaserDuration);
+      c.value = v;
+      out.ok = true;
+    }
   } else if (word == "pan") {
     // Two numbers: x into `value`, y kept as text in `arg` (the message has one number field).
     char* end = nullptr;
@@ -138,7 +151,8 @@ ParsedCommand parse_command_line(const std::string& line, const std::string& sou
   } else if (word == "invert") {
     simple(CommandCode::ToggleReinverter);
   } else {
-    out.error = "unknown command '" + word + "' (n, p, pause, resume, r, s NAME, w, l, z X, pan X Y, focus F, flat, wide, invert)";
+    out.error = "unknown command '" + word + "' (n, p, pause, resume, r, s NAME, w, l, z X, pan X Y, focus F, flat, wide, invert, "
+                "laser_power MW, laser_duration MS)";
   }
   return out;
 }
@@ -167,6 +181,16 @@ Verdict check_command(const vitreo_lcm::operator_command_t& cmd, const CommandLi
         return refuse(fmt::format("pan {:g} {:g} mm outside the rig's range ±{:g} mm", cmd.value, y, limits.pan_range_mm));
       break;
     }
+    case CommandCode::LaserPower:
+      if (!std::isfinite(cmd.value) || cmd.value < limits.laser_power_min_mw || cmd.value > limits.laser_power_max_mw)
+        return refuse(fmt::format("laser power {:g} mW outside the rig's range {:g}..{:g} mW", cmd.value,
+                                  limits.laser_power_min_mw, limits.laser_power_max_mw));
+      break;
+    case CommandCode::LaserDuration:
+      if (!std::isfinite(cmd.value) || cmd.value < limits.laser_duration_min_ms || cmd.value > limits.laser_duration_max_ms)
+        return refuse(fmt::format("laser pulse {:g} ms outside the rig's range {:g}..{:g} ms (a pulse per shot: no continuous mode)",
+                                  cmd.value, limits.laser_duration_min_ms, limits.laser_duration_max_ms));
+      break;
     case CommandCode::NextCase:
     case CommandCode::PreviousCase:
     case CommandCode::Pause:

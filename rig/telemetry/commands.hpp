@@ -40,7 +40,10 @@ enum class CommandCode : std::int8_t {
   ToggleShading = 12,      // flat / smooth shading of the tissue (the thesis' F2)
   ToggleWideAngle = 13,    // the wide-angle viewing system in / out
   ToggleReinverter = 14,   // the wide-angle image re-inverter on / off
+  LaserPower = 15,         // value = the endolaser's power (mW) for the shots that follow
+  LaserDuration = 16,      // value = the endolaser's pulse duration (ms) for the shots that follow
 };
+inline constexpr int kLastCommandCode = 16;
 const char* command_name(std::int8_t code) noexcept;
 
 // The rig's limits, fixed for a session (the stateless checks).
@@ -49,6 +52,13 @@ struct CommandLimits {
   double zoom_max = 25.0;
   double pan_range_mm = 20.0;    // |x|, |y| of a pan from the region of interest
   double focus_range_mm = 6.0;   // focus within ±half of this
+  // The endolaser console's settings (the rig file's [laser] table is held to them too). A shot is
+  // one pulse of power × duration (core/instruments: the burn's size follows its energy); the core
+  // has no continuous mode, so a duration is never 0.
+  double laser_power_min_mw = 50.0;
+  double laser_power_max_mw = 2000.0;
+  double laser_duration_min_ms = 10.0;
+  double laser_duration_max_ms = 2000.0;
 };
 
 // The session's state a command is decided against, as physics sees it at that moment.
@@ -83,6 +93,7 @@ bool valid_snapshot_name(const std::string& s);
 //   n | next            p | prev | previous        space | pause     resume
 //   r | reset           s NAME | save NAME          w | wireframe    l | labels
 //   z X | zoom X        pan X Y            focus F        flat        wide        invert
+//   laser_power MW      laser_duration MS
 // Returns the command (utime_us/source/seq filled from the arguments) or an error message. The
 // syntax is checked here (a snapshot name too: it is never shortened to fit), the rest by the rig,
 // which answers with an ack.

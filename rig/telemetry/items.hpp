@@ -129,13 +129,14 @@ struct Totals {
   double instrument_contact_time_s[kMaxInstruments] = {};
 };
 
-// The pedals' surgical controls (controls_t).
+// The pedals' surgical controls and the laser console's settings (controls_t).
 struct Controls {
   std::int64_t step = 0;
   double t_s = 0;
   double vacuum_mmhg = 0, cut_rate_cpm = 0;
-  bool reflux = false, laser_fire = false;
+  bool reflux = false, laser_fire = false, pick_out = false;
   double light_level = 0, zoom = 1;
+  double laser_power_mw = 0, laser_duration_ms = 0;
 };
 
 using TelemetryItem = std::variant<InstrumentState, Event, PhysicsTiming, DeviceStatus, Score, Criteria, Totals, Controls>;

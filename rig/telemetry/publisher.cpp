@@ -262,8 +262,11 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.cut_rate_cpm = v.cut_rate_cpm;
           m.reflux = v.reflux;
           m.laser_fire = v.laser_fire;
+          m.pick_out = v.pick_out;
           m.light_level = v.light_level;
           m.zoom = v.zoom;
+          m.laser_power_mw = v.laser_power_mw;
+          m.laser_duration_ms = v.laser_duration_ms;
           rc = publish(lcm_, kChanControls, m);
         }
       },

@@ -70,7 +70,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Send operator commands to a running vitreo rig over LCM and print its acknowledgement.\n"
       "Commands: n|next, p|prev, pause (or a line with one space), resume, r|reset, s|save NAME,\n"
-      "w|wireframe, l|labels, z|zoom X. Without a command, reads one command per line from stdin."};
+      "w|wireframe, l|labels, z|zoom X, pan X Y, focus F, flat, wide, invert, laser_power MW,\n"
+      "laser_duration MS. Without a command, reads one command per line from stdin."};
   std::string url = kDefaultLcmUrl;
   std::string source = "vitreo-cmd";
   int timeout_ms = 1000;

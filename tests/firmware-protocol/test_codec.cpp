@@ -165,6 +165,11 @@ TEST(ProtocolCodec, RangeValidation) {
   EXPECT_EQ(pose_with([&](auto& p) { p.q_wxyz[0] = 0.9f; }), VP_ERR_RANGE) << "not a unit quaternion";
   EXPECT_EQ(pose_with([&](auto& p) { p.quality_pct = 101; }), VP_ERR_RANGE);
   EXPECT_EQ(pose_with([&](auto& p) { p.tool_type = VP_TOOL_COUNT; }), VP_ERR_RANGE);
+  // PROTOCOL.md §3 and §4 (1.1): 9 blade and 10 sideways blade are tools, 11 is past the last one.
+  EXPECT_EQ(pose_with([&](auto& p) { p.tool_type = 9; }), VP_OK);
+  EXPECT_EQ(pose_with([&](auto& p) { p.tool_type = 10; }), VP_OK);
+  EXPECT_EQ(pose_with([&](auto& p) { p.tool_type = 11; }), VP_ERR_RANGE);
+  EXPECT_EQ(pose_with([&](auto& p) { p.tool_type = 255; }), VP_ERR_RANGE);
 
   vp_message e = sample(VP_MSG_EYEBALL_STATE, 1);
   e.u.eyeball.port_count = 2;  // port 3 in use beyond the count
@@ -204,9 +209,14 @@ TEST(ProtocolCodec, UnknownVersionsAndTypesAreReportedNotParsed) {
   longer.push_back(0xAA);
   longer[3] = std::uint8_t(longer[3] + 1);
   EXPECT_EQ(vp_decode_packet(longer.data(), longer.size(), &out), VP_ERR_LENGTH);
-  longer[0] = 0x11;
+  longer[0] = 0x10 | (VP_PROTO_MINOR + 1);
   EXPECT_EQ(vp_decode_packet(longer.data(), longer.size(), &out), VP_OK);
-  EXPECT_EQ(out.version_minor, 1);
+  EXPECT_EQ(out.version_minor, VP_PROTO_MINOR + 1);
+  // an older minor (1.0, before the blades) is read when its length is exact
+  Bytes older = p;
+  older[0] = 0x10;
+  EXPECT_EQ(vp_decode_packet(older.data(), older.size(), &out), VP_OK);
+  EXPECT_EQ(out.version_minor, 0);
   EXPECT_EQ(vp_decode_packet(p.data(), 3, &out), VP_ERR_TRUNCATED);
   EXPECT_EQ(vp_decode_packet(p.data(), p.size() - 1, &out), VP_ERR_TRUNCATED);
 }

@@ -18,7 +18,7 @@ check "identify on a missing port fails with a reason" '[ $rc -ne 0 ] && grep -q
 
 "$B" simulate --device pedals --link "$dir/tty" --duration-s 6 > "$dir/sim.out" 2>&1 & sim=$!
 for _ in $(seq 50); do [ -e "$dir/tty" ] && break; sleep 0.05; done
-check "identify the simulated pedals" '"$B" identify --serial "$dir/tty" 2>/dev/null | grep -q "^pedals serial 2001 .*protocol 1.0"'
+check "identify the simulated pedals" '"$B" identify --serial "$dir/tty" 2>/dev/null | grep -q "^pedals serial 2001 .*protocol 1.1"'
 check "identify them by their URI" '"$B" identify --device "serial:$dir/tty" 2>/dev/null | grep -q "^pedals serial 2001 "'
 "$B" identify --device "serial:$dir/tty?speed=1" > /dev/null 2> "$dir/err"; rc=$?
 check "a bad URI is refused with the reason" '[ $rc -ne 0 ] && [ "$(wc -l < "$dir/err")" -eq 1 ] && grep -q "unknown parameter" "$dir/err"'

@@ -109,6 +109,15 @@ TEST(Pedals, TravelSetsVacuumAndCutRateAndSwitchesAct) {
   ASSERT_TRUE(m.apply(r));
   EXPECT_EQ(m.controls().instrument_changes, 2u);
   EXPECT_TRUE(m.controls().laser_fire);
+  EXPECT_FALSE(m.controls().pick_out) << "the laser's switch is not the pick's";
+  r.switches = 1u << 4;  // the light pipe's pick: out while held
+  ASSERT_TRUE(m.apply(r));
+  EXPECT_TRUE(m.controls().pick_out);
+  EXPECT_FALSE(m.controls().laser_fire);
+  r.switches = 0;
+  ASSERT_TRUE(m.apply(r));
+  EXPECT_FALSE(m.controls().pick_out);
+  r.switches = (1u << 2) | (1u << 1);
   r.axes[0] = 0.0;
   ASSERT_TRUE(m.apply(r));
   EXPECT_EQ(m.controls().cut_rate_cpm, 0.0) << "no cutting without suction";
@@ -185,6 +194,8 @@ TEST(Pedals, ASwitchOrAxisDoingTwoJobsIsRefusedWithBothNames) {
   };
   refused("[pedals]\nlaser_switch = 0\n", "pedals.reflux_switch and pedals.laser_switch are the same switch (0)");
   refused("[pedals]\nair_switch = 2\n", "pedals.instrument_switch and pedals.air_switch are the same switch (2)");
+  refused("[pedals]\npick_switch = 1\n", "pedals.laser_switch and pedals.pick_switch are the same switch (1)");
+  refused("[pedals]\npick_switch = 16\n", "pedals.pick_switch: 16");
   refused("[pedals]\ncut_rate_axis = 0\n", "pedals.vacuum_axis and pedals.cut_rate_axis are the same axis (0)");
   refused("[pedals]\nlight_down_switch = 0\n", "the same switch");
   refused("[pedals]\nfocus_axis = 0\n", "the same axis");

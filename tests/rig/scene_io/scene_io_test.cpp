@@ -190,6 +190,14 @@ TEST(SceneFiles, ViewTableIsReadWithItsDefaults) {
   EXPECT_TRUE(v.view.chandelier);
 }
 
+// Issue 15: the core's blades can be offered by a case (a misspelt name is refused: bad/29_*).
+TEST(SceneFiles, CasesOfferTheStraightAndTheSidewaysBlade) {
+  const core::SceneDescription d = scene_io::parse_scene(
+      "format_version = 1\nname = \"b\"\n[instruments]\navailable = [\"blade\", \"sideways_blade\", \"light_pipe\"]\n",
+      "blades.toml");
+  EXPECT_EQ(d.instruments, (std::vector<std::string>{"blade", "sideways_blade", "light_pipe"}));
+}
+
 TEST(SceneFiles, MissingFileIsAnError) {
   EXPECT_THROW(scene_io::load_scene_file("/nonexistent/case.toml"), scene_io::SceneError);
 }

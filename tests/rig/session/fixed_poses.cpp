@@ -43,7 +43,9 @@ telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actu
   in.values[7] = actuation;
   in.values[8] = 1.0;
   in.values[9] = id;
-  in.values[10] = 3;
+  // Tool type (PROTOCOL.md): the light pipe's hand holds a light pipe (1); the tool hand a universal
+  // handpiece (0), so the case's first tool is in it, as golden/README.md says.
+  in.values[10] = id == kLightPipeTracker ? 1 : 0;
   return in;
 }
 

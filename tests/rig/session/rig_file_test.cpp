@@ -70,6 +70,9 @@ TEST(RigFile, TheBuiltRigNamesRealDevicesAndCarriesThePedalMapping) {
   ASSERT_TRUE(f.pedals.has_value());
   EXPECT_EQ(f.pedals->vacuum_max_mmhg, 650.0);
   EXPECT_EQ(f.pedals->cut_rate_max_cpm, 10000.0);
+  ASSERT_TRUE(f.laser.has_value());
+  EXPECT_EQ(f.laser->power_mw, 200.0);
+  EXPECT_EQ(f.laser->duration_ms, 100.0);
 }
 
 // The rig file the installed service reads (rig/system/): its serial devices by the names
@@ -148,4 +151,34 @@ TEST(RigFile, BadFilesAreRefusedWithFileLineAndKey) {
                 .find("'usb:1209:7a11' is given for two devices"),
             std::string::npos);
   EXPECT_NE(error_of(std::string(kHead) + kTracker + "[pedals]\nvacuum_axis = 9\n").find("pedals.vacuum_axis"), std::string::npos);
+}
+
+// The [laser] table: the endolaser's start settings, held to the operator commands' ranges.
+TEST(RigFile, TheLaserTableSetsPowerAndPulseDuration) {
+  const rig::RigFile f = rig::parse_rig_file(std::string(kHead) + kTracker + "[laser]\npower_mw = 350\nduration_ms = 150.5\n",
+                                             "t.toml", "/nonexistent");
+  ASSERT_TRUE(f.laser.has_value());
+  EXPECT_EQ(f.laser->power_mw, 350.0);
+  EXPECT_EQ(f.laser->duration_ms, 150.5);
+  const rig::RigFile half = rig::parse_rig_file(std::string(kHead) + kTracker + "[laser]\nduration_ms = 50\n", "t.toml", "/nonexistent");
+  ASSERT_TRUE(half.laser.has_value());
+  EXPECT_EQ(half.laser->power_mw, 200.0) << "the console's default";
+  EXPECT_EQ(half.laser->duration_ms, 50.0);
+  EXPECT_FALSE(rig::parse_rig_file(std::string(kHead) + kTracker, "t.toml", "/nonexistent").laser.has_value());
+  // The ends of the ranges are settings; past them, a non-number, an unknown key and a non-table are refused.
+  EXPECT_NO_THROW(rig::parse_rig_file(std::string(kHead) + kTracker + "[laser]\npower_mw = 50\nduration_ms = 2000\n", "t.toml", "/x"));
+  EXPECT_NO_THROW(rig::parse_rig_file(std::string(kHead) + kTracker + "[laser]\npower_mw = 2000.0\nduration_ms = 10\n", "t.toml", "/x"));
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[laser]\npower_mw = 2500\n").find("t.toml:9: laser.power_mw: must be a power in [50, 2000] mW"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[laser]\npower_mw = 49.9\n").find("t.toml:9: laser.power_mw"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[laser]\npower_mw = 200\nduration_ms = 0\n")
+                .find("t.toml:10: laser.duration_ms: must be a pulse duration in [10, 2000] ms"),
+            std::string::npos)
+      << "no continuous mode";
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[laser]\nduration_ms = nan\n").find("t.toml:9: laser.duration_ms"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[laser]\npower_mw = \"high\"\n").find("t.toml:9: laser.power_mw"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "[laser]\nwavelength_nm = 532\n").find("t.toml:9: laser.wavelength_nm: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kHead) + kTracker + "laser = 200\n").find("device[0].laser: unknown key"), std::string::npos);
+  EXPECT_NE(error_of("laser = 200\n" + std::string(kHead) + kTracker).find("t.toml:1: laser: must be a table"), std::string::npos);
 }

@@ -28,6 +28,7 @@
 #include "rig/session/snapshot_writer.hpp"
 #include "rig/telemetry/channels.hpp"
 #include "rig/session/device_inputs.hpp"
+#include "tests/rig/session/model_inputs.hpp"
 #include "vitreo_lcm/device_input_t.hpp"
 #include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/physics_timing_t.hpp"
@@ -476,14 +477,7 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
   const rig::ModelConfig mc = small_model();
   rig::SimulationModel model(mc);
   rig::SimulationModel fresh(mc);
-  auto command = [](int code, double value) {
-    telemetry::DeviceInput in;
-    in.device_kind = rig::kCommandKind;
-    in.n_values = 2;
-    in.values[0] = code;
-    in.values[1] = value;
-    return in;
-  };
+  const auto command = test::operator_command;
   for (int i = 0; i < 50; ++i) model.step();
   const auto moved = model.world().state_hash();
   EXPECT_NE(moved, fresh.world().state_hash());
@@ -578,6 +572,8 @@ TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReprod
     type("n\n", 1500);        // refused: already at the last case (loaded or still loading)
     type("s look-1\n", 100);  // a snapshot of the second case
     type("z 99\n", 100);      // refused: out of range
+    type("laser_power 400\n", 100);   // the endolaser's next shots
+    type("laser_duration 0\n", 100);  // refused: a pulse per shot, no continuous mode
     type("p\n", 300);         // back to the first case
     type("r\n", 1000);        // and reset it
   });
@@ -596,6 +592,11 @@ TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReprod
   EXPECT_NE(acks.find("> zoom: refused: zoom 99 outside"), std::string::npos) << acks;
   EXPECT_NE(acks.find("look-1.snapshot"), std::string::npos) << "the ack says where the snapshot goes:\n" << acks;
   EXPECT_NE(acks.find("> reset: accepted"), std::string::npos) << acks;
+  EXPECT_NE(acks.find("> laser_power: accepted"), std::string::npos) << acks;
+  EXPECT_NE(acks.find("> laser_duration: refused: laser pulse 0 ms outside"), std::string::npos) << acks;
+  EXPECT_EQ(live.laser_at_start.power_mw, 200.0);
+  EXPECT_EQ(live.laser_at_end.power_mw, 400.0) << "kept across the case switches and the reset";
+  EXPECT_EQ(live.laser_at_end.duration_ms, 100.0);
 
   // Loads: next, previous, reset — in that order (a reset arriving while "previous" is still
   // waiting for the loader merges with it: the same case, loaded once).
@@ -636,6 +637,7 @@ TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReprod
   const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
   EXPECT_EQ(replay.steps, live.steps);
   EXPECT_EQ(replay.state_hash, live.state_hash) << "the recorded case switches replay at the same steps";
+  // (The laser's settings are in the state hash: the replay applied the recorded laser_power too.)
   std::filesystem::remove_all(config.snapshot_dir);
   std::filesystem::remove(config.record_path);
 }

@@ -196,6 +196,19 @@ TEST_F(Resolving, PedalsAndToolSwitchesFollowTheWaypoints) {
   }
   EXPECT_EQ(presses, 1);
   EXPECT_DOUBLE_EQ(last_vacuum, 0.5);
+  // The light pipe's pick: its own switch held from its waypoint on, never the laser's.
+  const ResolvedScript picked = resolve_script(
+      parse_surgical_script(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\npick = true\n", "k.toml"), *case_,
+      PedalMapping{});
+  drivers::sim::Script pick_pedals;
+  ASSERT_TRUE(drivers::sim::parse_script(picked.device_scripts.at("pedals"), pick_pedals, &err)) << err;
+  const unsigned last_switches = static_cast<unsigned>(pick_pedals.keys.back().second[2]);
+  EXPECT_EQ(last_switches, 1u << PedalMapping{}.pick_switch);
+  // The presses choose the tool only because the working hand's handpiece names none (tool type 0):
+  // a handpiece that names its tool would pin it (rig/runtime/README.md, tracker mapping).
+  drivers::sim::Script hand;
+  ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("tracker-0"), hand, &err)) << err;
+  EXPECT_EQ(hand.tool, 0);
 }
 
 }  // namespace

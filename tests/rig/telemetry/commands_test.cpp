@@ -76,6 +76,19 @@ TEST(CommandValidation, AcceptsValidCommandsAndRefusesBadOnesWithAReason) {
   EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_WIDE_ANGLE), ctx).accepted);
   EXPECT_TRUE(validate_command(make(Cmd::TOGGLE_REINVERTER), ctx).accepted);
 
+  // The endolaser's settings: 50..2000 mW, 10..2000 ms (a pulse per shot, never 0: no continuous mode).
+  EXPECT_TRUE(validate_command(make(Cmd::LASER_POWER, 1, 50.0), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::LASER_POWER, 1, 2000.0), ctx).accepted);
+  EXPECT_EQ(validate_command(make(Cmd::LASER_POWER, 1, 2500.0), ctx).reason, "laser power 2500 mW outside the rig's range 50..2000 mW");
+  EXPECT_FALSE(validate_command(make(Cmd::LASER_POWER, 1, 49.0), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::LASER_POWER, 1, std::nan("")), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::LASER_DURATION, 1, 10.0), ctx).accepted);
+  EXPECT_TRUE(validate_command(make(Cmd::LASER_DURATION, 1, 2000.0), ctx).accepted);
+  EXPECT_EQ(validate_command(make(Cmd::LASER_DURATION, 1, 0.0), ctx).reason,
+            "laser pulse 0 ms outside the rig's range 10..2000 ms (a pulse per shot: no continuous mode)");
+  EXPECT_FALSE(validate_command(make(Cmd::LASER_DURATION, 1, 2001.0), ctx).accepted);
+  EXPECT_FALSE(validate_command(make(Cmd::LASER_DURATION, 1, -std::numeric_limits<double>::infinity()), ctx).accepted);
+
   EXPECT_TRUE(validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, "before-peel_2.v1"), ctx).accepted);
   for (const char* bad : {"", "../etc/passwd", "a/b", ".hidden", "spa ce", "x\n"}) {
     const Verdict v = validate_command(make(Cmd::SAVE_SNAPSHOT, 1, 0, bad), ctx);
@@ -226,7 +239,8 @@ TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
                         Case{"zoom 12.5", Cmd::ZOOM, 12.5, ""}, Case{"z 8\n", Cmd::ZOOM, 8, ""},
                         Case{"pan 1.5 -2", Cmd::PAN, 1.5, "-2"}, Case{"focus -0.75", Cmd::FOCUS, -0.75, ""},
                         Case{"flat", Cmd::TOGGLE_SHADING, 0, ""}, Case{"wide", Cmd::TOGGLE_WIDE_ANGLE, 0, ""},
-                        Case{"invert", Cmd::TOGGLE_REINVERTER, 0, ""}}) {
+                        Case{"invert", Cmd::TOGGLE_REINVERTER, 0, ""}, Case{"laser_power 350", Cmd::LASER_POWER, 350, ""},
+                        Case{"laser_duration 0.15e3", Cmd::LASER_DURATION, 150, ""}}) {
     const ParsedCommand p = parse_command_line(k.line, "terminal", 7);
     ASSERT_TRUE(p.ok) << "'" << k.line << "': " << p.error;
     EXPECT_EQ(p.command.command, k.code) << k.line;
@@ -239,7 +253,8 @@ TEST(CommandLine, ParsesTheTerminalSpellingAndRejectsBadSyntax) {
   for (const char* bad : {"", "   ", "zoom", "zoom x", "zoom 3x", "save", "n 3", "fly",
                           "s aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa", "s ../x", "s .hidden",
                           "zoom nan", "zoom inf", "z -inf", "zoom 1e999", "pan", "pan 1", "pan 1 x",
-                          "pan 1 2 3", "focus", "focus far", "wide 2", "focus nan", "pan 1e999 0", "pan 0 -1e999"}) {
+                          "pan 1 2 3", "focus", "focus far", "wide 2", "focus nan", "pan 1e999 0", "pan 0 -1e999",
+                          "laser_power", "laser_power 200mW", "laser_duration", "laser_duration 100 ms", "laser_power inf"}) {
     const ParsedCommand p = parse_command_line(bad, "terminal", 1);
     EXPECT_FALSE(p.ok) << "'" << bad << "' parsed";
     EXPECT_FALSE(p.error.empty());

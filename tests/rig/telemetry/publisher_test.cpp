@@ -209,8 +209,11 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   k.cut_rate_cpm = 5000;
   k.reflux = true;
   k.laser_fire = true;
+  k.pick_out = true;
   k.light_level = 0.7;
   k.zoom = 1.5;
+  k.laser_power_mw = 350;
+  k.laser_duration_ms = 120;
   ASSERT_TRUE(physics.push(k));
 
   EXPECT_EQ(pub.pump(), 5u);
@@ -271,8 +274,11 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   EXPECT_DOUBLE_EQ(kg.cut_rate_cpm, 5000);
   EXPECT_TRUE(kg.reflux);
   EXPECT_TRUE(kg.laser_fire);
+  EXPECT_TRUE(kg.pick_out);
   EXPECT_DOUBLE_EQ(kg.light_level, 0.7);
   EXPECT_DOUBLE_EQ(kg.zoom, 1.5);
+  EXPECT_DOUBLE_EQ(kg.laser_power_mw, 350);
+  EXPECT_DOUBLE_EQ(kg.laser_duration_ms, 120);
   EXPECT_GT(kg.utime_us, 0);
 }
 
