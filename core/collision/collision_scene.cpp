@@ -325,6 +325,7 @@ void CollisionScene::update(const TissueWorld& world, std::span<const ColliderCa
     const double motion = std::max(motion_a.norm(), motion_b.norm());
     for (std::uint32_t h = begin[k]; h < begin[k + 1]; ++h) {
       const Patch& p = m.patches[m.collider_hits[h]];
+      if (p.surface < 32 && ((options_.pass_through_mask >> p.surface) & 1u) != 0) continue;
       {  // the patch's bounding sphere first
         double sp = 0.0, tq = 0.0;
         const Vec3 center = p.fat.center();

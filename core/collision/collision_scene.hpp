@@ -47,6 +47,10 @@ struct CollisionOptions {
   // Other awake patches are refit every this many steps (round-robin): the margin must cover how far
   // tissue away from the instruments moves in that time (0.4 mm in 32 ms: up to 12 mm/s).
   std::uint32_t far_refit_period = 32;
+  // Surfaces the instruments pass through (bit i: surface i): no contact candidates are made on
+  // them. The vitreous gel's shells stand in for a gel volume that is 99 % water; a shaft moves
+  // through it instead of pushing a sheet ahead of it (InstrumentSystem sets the gel's bit).
+  std::uint32_t pass_through_mask = 0;
 };
 
 struct CollisionStats {

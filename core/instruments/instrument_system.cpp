@@ -47,6 +47,10 @@ InstrumentSystem::InstrumentSystem(TissueWorld& world, InstrumentSceneOptions op
   }
   require_range(options_.port_stiffness_un_per_mm, 0.0, 1e9, "instruments: port stiffness");
   require_range(options_.eye_rotation_stiffness_un_mm_per_rad, 1.0, 1e12, "instruments: eye rotation stiffness");
+  if (options_.vitreous_surface != kNone) {
+    if (options_.vitreous_surface >= 32) throw InvalidArgument("instruments: vitreous surface index beyond the pass-through mask");
+    options_.collision.pass_through_mask |= 1u << options_.vitreous_surface;
+  }
   collision_ = std::make_unique<CollisionScene>(world, options_.collision, options_.anatomy);
   const std::size_t n = instruments.size();
   state_.resize(n);

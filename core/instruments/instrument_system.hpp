@@ -106,6 +106,8 @@ struct InstrumentSceneOptions {
   std::uint32_t retina_surface = kNone;
   // Tissue the endolaser's beam passes through: the vitreous gel is optically clear, so the beam
   // burns the retina (its pigment epithelium) behind it; the gel neither stops nor takes a burn.
+  // The instruments pass through it too (CollisionOptions::pass_through_mask): only the vitrector's
+  // suction and cutter act on the gel.
   std::uint32_t vitreous_surface = kNone;
   std::optional<Vec3> macula_mm;
   std::vector<DrainageSite> drainage_sites;

@@ -854,6 +854,33 @@ TEST(Instruments, AShaftAlongAnAnchoredRimPressesTheSheetAndFlingsNothing) {
   EXPECT_LT(stretch, 0.3);
 }
 
+// The vitreous gel's shells stand for a gel volume the instruments pass through: a shaft pushed 2 mm
+// through an anchored sheet named as the vitreous leaves it where it was, while the same sheet as
+// ordinary tissue is pushed ahead of the tip.
+TEST(Instruments, AShaftPassesThroughTheVitreousGelAndPushesOtherTissue) {
+  auto push_through = [](bool as_vitreous) {
+    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
+    const double size = 6.0;
+    const std::uint32_t m = world.add_surface(sheet(size, 24, 0.0));
+    anchor_border(world.surface(m), size);
+    InstrumentSceneOptions o;
+    const Vec3 port(0.1, 0.1, 8.0);
+    o.ports_mm = {port};
+    if (as_vitreous) o.vitreous_surface = m;
+    Simulation sys(world, o, {{InstrumentKind::kDrainageNeedle, Gauge::k23, 0, {}}});
+    for (int i = 0; i <= 1000; ++i) {  // tip from z = +1 to z = -2 at 3 mm/s
+      EXPECT_TRUE(sys.set_input(0, InstrumentInput::through_port(port, -Vec3::UnitZ(), 7.0 + 3.0 * i / 1000)));
+      EXPECT_TRUE(sys.step(kDt).tissue.ok);
+    }
+    const Surface& sh = world.surface(m);
+    double moved = 0.0;
+    for (std::uint32_t v = 0; v < sh.vertex_slots(); ++v) moved = std::max(moved, (sh.position(v) - sh.rest_position(v)).norm());
+    return moved;
+  };
+  EXPECT_LT(push_through(true), 0.01);  // what it sags under its own weight in that second: µm
+  EXPECT_GT(push_through(false), 1.0);
+}
+
 // Attached retina (every vertex fixed on the wall) pressed by a 23 G tip: nothing moves, yet the tip
 // squeezes the retina's 0.25 mm against the sclera. The force grows from nothing at first touch as
 // an elastic foundation's (π E_c R δ²/t, E_c the confined modulus at ν = 1/3), so a gentle touch is
