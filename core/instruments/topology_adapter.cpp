@@ -1,9 +1,12 @@
 #include "core/instruments/topology_adapter.hpp"
 
+#include <algorithm>
+
 namespace vitreo::core {
 
 TopologyAdapter::TopologyAdapter(TissueWorld& world, const std::vector<std::uint32_t>& cut_surfaces,
-                                 const std::vector<std::uint32_t>& removal_surfaces, CutSettings cut, VitrectorSettings vitrector) {
+                                 const std::vector<std::uint32_t>& removal_surfaces, CutSettings cut, VitrectorSettings vitrector,
+                                 std::uint32_t aspirated_surface) {
   for (auto s : cut_surfaces) {
     if (s >= world.surface_count()) throw InvalidArgument("topology adapter: cut surface out of range");
     cutters_.push_back(std::make_unique<Cutter>(world.surface(s), cut));
@@ -14,7 +17,8 @@ TopologyAdapter::TopologyAdapter(TissueWorld& world, const std::vector<std::uint
   vitrector.removal_radius_mm = std::max(vitrector.removal_radius_mm, 1e-3);
   for (auto s : removal_surfaces) {
     if (s >= world.surface_count()) throw InvalidArgument("topology adapter: removal surface out of range");
-    vitrectors_.push_back(std::make_unique<Vitrector>(world.surface(s), vitrector));
+    const RemovalModel model = s == aspirated_surface ? RemovalModel::kAspirate : RemovalModel::kClip;
+    vitrectors_.push_back(std::make_unique<Vitrector>(world.surface(s), vitrector, model));
   }
 }
 
@@ -55,6 +59,7 @@ void TopologyAdapter::remove(TissueWorld& /*world*/, const RemovalRequest& reque
   for (auto& v : vitrectors_) {
     Status s = v->set_pose(request.port_center_mm, request.port_normal);
     if (s) s = v->set_cut_rate(std::min(request.cut_rate_cpm, v->settings().max_cut_rate_cpm));
+    if (s) s = v->set_vacuum(std::clamp(request.vacuum, 0.0, 1.0));
     if (!s) {
       last_error_ = s;
       continue;

@@ -25,9 +25,11 @@ class TopologyAdapter final : public TopologyActions {
  public:
   static constexpr std::uint32_t kMaxInstruments = 8;
   // cut_surfaces: surfaces blades and scissors cut; removal_surfaces: surfaces the vitrector removes
-  // (gel, membranes). Throws InvalidArgument for surfaces out of range.
+  // (gel, membranes); of those, aspirated_surface (the vitreous gel, or kNone) is aspirated as a
+  // volume and the others are clipped (vitrector.hpp). Throws InvalidArgument for surfaces out of range.
   TopologyAdapter(TissueWorld& world, const std::vector<std::uint32_t>& cut_surfaces,
-                  const std::vector<std::uint32_t>& removal_surfaces, CutSettings cut = {}, VitrectorSettings vitrector = {});
+                  const std::vector<std::uint32_t>& removal_surfaces, CutSettings cut = {}, VitrectorSettings vitrector = {},
+                  std::uint32_t aspirated_surface = kNone);
 
   void cut(TissueWorld& world, const CuttingPose& pose) override;
   void remove(TissueWorld& world, const RemovalRequest& request) override;

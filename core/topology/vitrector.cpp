@@ -12,6 +12,7 @@ void VitrectorSettings::validate() const {
   require_range(suction_pa, 0.0, 1e5, "vitrector: suction_pa");
   require_range(field_radius_mm, 0.01, 20.0, "vitrector: field_radius_mm");
   require_range(removal_radius_mm, 0.005, field_radius_mm, "vitrector: removal_radius_mm");
+  require_range(gel_flow_mm3_per_s, 0.0, 1e4, "vitrector: gel_flow_mm3_per_s");
   require_range(max_cut_rate_cpm, 0.0, 1e5, "vitrector: max_cut_rate_cpm");
   require_range(cut_rate_cpm, 0.0, max_cut_rate_cpm, "vitrector: cut_rate_cpm");
   require_range(leaving_damping_per_s, 0.0, 1e4, "vitrector: leaving_damping_per_s");
@@ -20,8 +21,8 @@ void VitrectorSettings::validate() const {
   quality.validate();
 }
 
-Vitrector::Vitrector(Surface& surface, VitrectorSettings settings)
-    : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality) {
+Vitrector::Vitrector(Surface& surface, VitrectorSettings settings, RemovalModel model)
+    : surface_(surface), settings_(settings), index_(surface), quality_(surface, settings.quality), model_(model) {
   settings_.validate();
   const std::size_t nv = surface.vertex_capacity(), ne = surface.edge_capacity();
   reserve_touched(samples_, nv);
@@ -31,6 +32,7 @@ Vitrector::Vitrector(Surface& surface, VitrectorSettings settings)
   reserve_touched(triangles_, ne);
   tri_stamp_.assign(ne, 0);
   reserve_touched(crossings_, ne);
+  reserve_touched(candidates_, ne);
 }
 
 Status Vitrector::set_pose(const Vec3& port, const Vec3& direction) {
@@ -48,6 +50,12 @@ Status Vitrector::set_cut_rate(double cpm) {
     return Status::error("vitrector: cut rate must be finite and in [0, max_cut_rate_cpm]");
   }
   cut_rate_cpm_ = cpm;
+  return Status::ok();
+}
+
+Status Vitrector::set_vacuum(double vacuum) {
+  if (!std::isfinite(vacuum) || vacuum < 0.0 || vacuum > 1.0) return Status::error("vitrector: vacuum must be finite and in [0, 1]");
+  vacuum_ = vacuum;
   return Status::ok();
 }
 
@@ -96,7 +104,11 @@ VitrectorStepResult Vitrector::apply(double dt) {
     cut_phase_ += dt * cut_rate_cpm_ / 60.0;
     if (cut_phase_ >= 1.0) {
       cut_phase_ -= std::floor(cut_phase_);
-      remove(r);
+      if (model_ == RemovalModel::kAspirate) {
+        aspirate(r, 60.0 / cut_rate_cpm_);
+      } else {
+        remove(r);
+      }
     }
   }
   return r;
@@ -108,8 +120,67 @@ VitrectorStepResult Vitrector::cut_now() {
     r.status = Status::error("vitrector: no pose set");
     return r;
   }
-  remove(r);
+  if (model_ == RemovalModel::kAspirate) {
+    aspirate(r, cut_rate_cpm_ > 0.0 ? 60.0 / cut_rate_cpm_ : 0.0);
+  } else {
+    remove(r);
+  }
   return r;
+}
+
+void Vitrector::aspirate(VitrectorStepResult& r, double since_last_cut_s) {
+  r.cut = true;
+  Surface& s = surface_;
+  const double field = std::max(settings_.field_radius_mm * vacuum_, settings_.removal_radius_mm);
+  const double thickness = s.material().thickness_mm;
+  ++round_;
+  candidates_.clear();
+  index_.for_each_in_box(Vec3(port_.array() - field), Vec3(port_.array() + field), [&](std::uint32_t v) {
+    s.for_each_triangle_of(v, [&](std::uint32_t t, std::uint32_t) {
+      if (tri_stamp_[t] == round_) return;
+      tri_stamp_[t] = round_;
+      const auto tv = s.triangle_vertices(t);
+      const Vec3 d = (s.position(tv[0]) + s.position(tv[1]) + s.position(tv[2])) / 3.0 - port_;
+      // In the field's hemisphere, whose flat side the port's opening (removal radius) reaches
+      // around: a coarse shell curving away behind the port's plane is still drawn in.
+      if (d.squaredNorm() > field * field || d.dot(dir_) < -settings_.removal_radius_mm) return;
+      candidates_.push_back({d.squaredNorm(), t});
+    });
+  });
+  if (candidates_.empty()) {
+    aspirated_mm3_ = 0.0;  // no gel at the port: it draws fluid
+    return;
+  }
+  // Room for the fans the removal may separate: at most one copy per corner.
+  if (!s.has_room(3 * static_cast<std::uint32_t>(candidates_.size()) + 3, 0, 0)) {
+    r.status = Status::error("vitrector: pools full (raise the surface capacity)");
+    return;
+  }
+  aspirated_mm3_ += settings_.gel_flow_mm3_per_s * vacuum_ * since_last_cut_s;
+  std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& a, const Candidate& b) {
+    return a.distance2 < b.distance2 || (a.distance2 == b.distance2 && a.triangle < b.triangle);
+  });
+  inside_.clear();
+  for (const Candidate& c : candidates_) {
+    if (!s.triangle_alive(c.triangle)) continue;
+    const double volume = s.triangle_rest_area(c.triangle) * thickness;
+    if (volume > aspirated_mm3_) break;  // nearest first: the next bite pays for it
+    const auto tv = s.triangle_vertices(c.triangle);
+    const auto removed = s.remove_triangle(s.triangle_id(c.triangle), false);
+    if (!removed.status) continue;
+    aspirated_mm3_ -= volume;
+    ++r.triangles_removed;
+    r.vertices_removed += removed.vertices_removed;
+    r.removed_area_mm2 += removed.removed_area_mm2;
+    r.removed_mass_g += removed.removed_mass_g;
+    for (auto v : tv) {
+      if (s.vertex_alive(v) && stamp_[v] != round_) {
+        stamp_[v] = round_;
+        inside_.push_back(v);
+      }
+    }
+  }
+  finish_removal(r);
 }
 
 void Vitrector::remove(VitrectorStepResult& r) {
@@ -226,6 +297,11 @@ void Vitrector::remove(VitrectorStepResult& r) {
     r.removed_area_mm2 += removed.removed_area_mm2;
     r.removed_mass_g += removed.removed_mass_g;
   }
+  finish_removal(r);
+}
+
+void Vitrector::finish_removal(VitrectorStepResult& r) {
+  Surface& s = surface_;
   // Bow-ties left by the removal: one vertex per fan (pools were checked for this above).
   const std::size_t n_inside = inside_.size();
   for (std::size_t i = 0; i < n_inside; ++i) {

@@ -20,6 +20,15 @@
 // triangles inside are removed with their mass (Surface::remove_triangle): the reported removed
 // mass is exactly what total_mass() loses.
 //
+// Aspiration (RemovalModel::kAspirate, the vitreous gel): a gel shell is not a sheet but stands for
+// the layer of gel around it (its material thickness), and gel is not clipped by the port's rim:
+// it flows into the port as a volume. The port aspirates gel_flow_mm3_per_s at full vacuum (in
+// proportion to the vacuum; none while the cutter is off: uncut gel plugs the port, Magalhaes et
+// al. 2008). Each cut takes its bite: whole triangles, nearest to the port first, within the suction
+// field (its hemisphere, reaching removal_radius_mm behind the port's plane), as long as the volume
+// aspirated since the last bite (rest area × thickness) pays for them.
+// The flow only accrues while gel is in the field (otherwise the port draws fluid).
+//
 // No allocation: scratch is sized to the surface's capacity when built.
 #include <cstdint>
 #include <vector>
@@ -37,6 +46,10 @@ struct VitrectorSettings {
   double suction_pa = 300.0;        // suction pressure at the port at full vacuum (the solver's SuctionField)
   double field_radius_mm = 1.5;     // suction hemisphere at full vacuum; the leaving damping acts in it
   double removal_radius_mm = 0.3;   // what enters this hemisphere is cut away
+  // Gel aspirated at full vacuum and 7500 cpm. Porcine vitreous through 23-25 G probes: 0.5-2 ml/min
+  // (Magalhaes et al., Retina 2008: 25 G, 500 mmHg: up to 0.015 ml/s; Abulon & Buboltz, TVST 2016:
+  // 23 G flows most at 7500 cpm); 1.5 ml/min here.
+  double gel_flow_mm3_per_s = 25.0;
   double cut_rate_cpm = 7500.0;     // the console's cut rate, cuts per minute
   double max_cut_rate_cpm = 10000.0;
   double leaving_damping_per_s = 50.0;
@@ -59,14 +72,21 @@ struct VitrectorStepResult {
   std::uint32_t unresolved = 0;  // slivers the cleanup could not remove
 };
 
+// How a surface is removed: clipped at the port's hemisphere (sheets: retina, membranes), or
+// aspirated as a volume (the gel's shells).
+enum class RemovalModel : std::uint8_t { kClip, kAspirate };
+
 class Vitrector {
  public:
-  explicit Vitrector(Surface& surface, VitrectorSettings settings = {});
+  explicit Vitrector(Surface& surface, VitrectorSettings settings = {}, RemovalModel model = RemovalModel::kClip);
 
   // Port position and suction direction (out of the port, into the eye). Refuses non-finite values
   // and a zero direction, changing nothing.
   Status set_pose(const Vec3& port_mm, const Vec3& suction_direction);
   Status set_cut_rate(double cuts_per_minute);  // 0 (cutter off)..max_cut_rate_cpm
+  // The pedal's vacuum, 0..1 of the maximum: scales the aspiration model's flow and field (the
+  // clipping model's hemisphere does not depend on it). Default 1.
+  Status set_vacuum(double vacuum);
 
   // The leaving damping for this step, and removal if the guillotine cuts during it.
   VitrectorStepResult apply(double dt_s);
@@ -80,13 +100,22 @@ class Vitrector {
  private:
   double region(const Vec3& x) const;  // < 0 inside the removal hemisphere
   void remove(VitrectorStepResult& r);
+  void aspirate(VitrectorStepResult& r, double since_last_cut_s);
+  void finish_removal(VitrectorStepResult& r);  // bow-ties and slivers around inside_
 
   Surface& surface_;
   VitrectorSettings settings_;
   VertexIndex index_;  // the field and the removal region visit only the vertices near the port
   MeshQuality quality_;
   Vec3 port_ = Vec3::Zero(), dir_ = Vec3::UnitZ();
-  double cut_rate_cpm_ = 0.0, cut_phase_ = 0.0;
+  RemovalModel model_ = RemovalModel::kClip;
+  double cut_rate_cpm_ = 0.0, cut_phase_ = 0.0, vacuum_ = 1.0;
+  double aspirated_mm3_ = 0.0;  // aspirated since the last bite, not yet spent on a triangle
+  struct Candidate {
+    double distance2;
+    std::uint32_t triangle;
+  };
+  std::vector<Candidate> candidates_;
   bool posed_ = false;
   double removed_mass_g_ = 0.0;
   std::vector<AccelerationSample> samples_;

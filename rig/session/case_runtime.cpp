@@ -153,7 +153,7 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   }
   std::vector<std::uint32_t> surfaces;
   for (std::uint32_t i = 0; i < s.world.surface_count(); ++i) surfaces.push_back(i);
-  out->topology = std::make_unique<core::TopologyAdapter>(s.world, surfaces, surfaces, core::CutSettings{}, o.vitrector);
+  out->topology = std::make_unique<core::TopologyAdapter>(s.world, surfaces, surfaces, core::CutSettings{}, o.vitrector, s.gel);
   out->sim = std::make_unique<core::Simulation>(s.world, o, instruments);
   out->sim->set_topology(out->topology.get());
   out->metrics = std::make_unique<core::SessionMetrics>(s, out->sim.get());

@@ -50,6 +50,93 @@ TEST(Vitrector, RemovesWhatEntersTheRemovalHemisphereClippedAtItsBoundary) {
   }
 }
 
+// The gel's model: aspirated as a volume (rest area × the material's thickness) at the flow rate,
+// whole triangles, nearest to the port first, within the suction field's hemisphere.
+SurfaceDescription gel_sheet() {
+  SurfaceDescription d = sheet(12.0, 12.0, 30, 30, 0.2, 5);
+  d.material.thickness_mm = 2.5;  // a gel shell stands for a 2.5 mm layer
+  return d;
+}
+struct AspirationSheet {
+  Surface s{gel_sheet()};
+  double thickness = s.material().thickness_mm;
+  // Rest area of the live triangles whose (current) centroid is within `r` of p.
+  double area_within(const Vec3& p, double r) const {
+    double a = 0.0;
+    for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
+      if (!s.triangle_alive(t)) continue;
+      const auto tv = s.triangle_vertices(t);
+      if (((s.position(tv[0]) + s.position(tv[1]) + s.position(tv[2])) / 3.0 - p).norm() <= r) a += s.triangle_rest_area(t);
+    }
+    return a;
+  }
+};
+
+TEST(VitrectorAspiration, TakesTheGelAtTheFlowRateNearestFirstAndOnlyInTheField) {
+  AspirationSheet g;
+  const double area0 = g.s.total_rest_area(), mass0 = g.s.total_mass();
+  VitrectorSettings vs;  // the rig's: 1.5 mm field, 25 mm³/s at full vacuum, 7500 cpm
+  Vitrector vit(g.s, vs, RemovalModel::kAspirate);
+  const Vec3 port(6.0, 6.0, 0.3);  // 0.3 mm above the sheet's middle, sucking down
+  ASSERT_TRUE(vit.set_pose(port, Vec3(0, 0, -1)));
+  ASSERT_TRUE(vit.set_cut_rate(vs.cut_rate_cpm));
+  ASSERT_TRUE(vit.set_vacuum(1.0));
+  const double in_field0 = g.area_within(port, vs.field_radius_mm);
+  // 0.2 s: 5 mm³ aspirated, 2 mm² of a 2.5 mm-thick sheet; the field holds more than that.
+  double removed = 0.0;
+  for (int k = 0; k < 200; ++k) {
+    const auto r = vit.apply(1e-3);
+    ASSERT_TRUE(r.status) << r.status.message();
+    removed += r.removed_area_mm2;
+  }
+  const double expected = vs.gel_flow_mm3_per_s * 0.2 / g.thickness;
+  ASSERT_GT(in_field0, 2.0 * expected);
+  // Whole triangles: what was paid for, less at most the one triangle the next bite pays for.
+  const double largest = 2.0 * (12.0 / 30) * (12.0 / 30);  // a jittered cell's triangle, generously
+  EXPECT_LE(removed, expected + 1e-9);
+  EXPECT_GE(removed, expected - largest);
+  EXPECT_NEAR(g.s.total_rest_area(), area0 - removed, 1e-9 * area0);
+  EXPECT_LT(g.s.total_mass(), mass0);
+  // Nearest first: the sheet around the port's foot is gone, the field's rim is untouched.
+  EXPECT_NEAR(g.area_within(Vec3(6.0, 6.0, 0.0), 0.5), 0.0, 1e-12);
+  const double rim0 = AspirationSheet().area_within(Vec3(6.0, 6.0, 0.0), 1.45) - AspirationSheet().area_within(Vec3(6.0, 6.0, 0.0), 1.2);
+  EXPECT_NEAR(g.area_within(Vec3(6.0, 6.0, 0.0), 1.45) - g.area_within(Vec3(6.0, 6.0, 0.0), 1.2), rim0, 1e-9);
+  // Nothing outside the field, ever: after 5 s everything within reach is gone and no more.
+  for (int k = 0; k < 5000; ++k) ASSERT_TRUE(vit.apply(1e-3).status);
+  EXPECT_NEAR(g.area_within(port, vs.field_radius_mm), 0.0, 1e-12);
+  EXPECT_NEAR(g.s.total_rest_area(), area0 - in_field0, 1e-9 * area0);
+  const auto report = check_surface(g.s, ValidityLimits{});
+  EXPECT_TRUE(report.ok()) << report.summary();
+}
+
+TEST(VitrectorAspiration, FlowFollowsTheVacuumStopsWithTheCutterAndDoesNotAccrueWithoutGel) {
+  const Vec3 port(6.0, 6.0, 0.3), away(6.0, 6.0, 5.0);
+  auto removed_in = [&](double vacuum, double cut_rate, double seconds, bool start_away) {
+    AspirationSheet g;
+    VitrectorSettings vs;
+    Vitrector vit(g.s, vs, RemovalModel::kAspirate);
+    EXPECT_TRUE(vit.set_vacuum(vacuum));
+    EXPECT_TRUE(vit.set_cut_rate(cut_rate));
+    if (start_away) {  // a second of vacuum in fluid, away from the gel
+      EXPECT_TRUE(vit.set_pose(away, Vec3(0, 0, 1)));
+      for (int k = 0; k < 1000; ++k) EXPECT_TRUE(vit.apply(1e-3).status);
+    }
+    EXPECT_TRUE(vit.set_pose(port, Vec3(0, 0, -1)));
+    double removed = 0.0;
+    for (int k = 0; k < static_cast<int>(seconds * 1000); ++k) removed += vit.apply(1e-3).removed_area_mm2;
+    return removed;
+  };
+  const double thickness = AspirationSheet().thickness, flow = VitrectorSettings{}.gel_flow_mm3_per_s;
+  const double full = removed_in(1.0, 7500.0, 0.1, false), half = removed_in(0.5, 7500.0, 0.2, false);
+  EXPECT_NEAR(full, flow * 0.1 / thickness, 0.15);  // 1 mm², in triangles of 0.08 mm²
+  EXPECT_NEAR(half, full, 0.15);  // half the vacuum: the same gel in twice the time
+  EXPECT_EQ(removed_in(1.0, 0.0, 0.5, false), 0.0);  // uncut gel plugs the port
+  // Vacuum in fluid aspirates fluid: arriving at the gel, the first bite is one cut's worth, not a second's.
+  EXPECT_LT(removed_in(1.0, 7500.0, 0.01, true), flow * 0.01 / thickness + 0.2);
+  AspirationSheet g;
+  EXPECT_FALSE(Vitrector(g.s, VitrectorSettings{}, RemovalModel::kAspirate).set_vacuum(1.5));
+}
+
 // Suction is the solver's (a SuctionField, as the instruments hand it over); the vitrector cuts what
 // it draws into the port, at the cut rate.
 TEST(Vitrector, CutsOnlyAtTheCutRateWhatTheSuctionDrawsIn) {

@@ -12,6 +12,8 @@
 //   - the vitrector's guillotine flickers across its port at the cut rate.
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -381,6 +383,13 @@ TEST_F(CaseCues, GelHazeIsGoneWhereTheVitrectorRemovedGel) {
     return out;
   };
   const std::vector<core::Vec3> gel_before = alive_points(g0);
+  std::vector<std::array<core::Vec3, 3>> triangles0(g0.triangle_slots());  // each live triangle's corners
+  std::vector<core::TriangleId> ids0;
+  for (std::uint32_t t = 0; t < g0.triangle_slots(); ++t) {
+    if (!g0.triangle_alive(t)) continue;
+    ids0.push_back(g0.triangle_id(t));
+    for (int k = 0; k < 3; ++k) triangles0[t][static_cast<std::size_t>(k)] = g0.position(g0.triangle_vertices(t)[static_cast<std::size_t>(k)]);
+  }
   // Ports facing the shell from inside, one cut each, spiralling out from the target vertex to 1 mm
   // (the cutter bites from tissue already at its port outward, as a surgeon works a gel edge).
   const core::Vec3 outward = target.normalized();
@@ -416,7 +425,14 @@ TEST_F(CaseCues, GelHazeIsGoneWhereTheVitrectorRemovedGel) {
                                                       (m.material == vr::MaterialKind::Static && m.id % 1000 > 50); });
   };
   const vr::Image a = render(gel_only(before), kW, kH).eye(0), b = render(gel_only(after), kW, kH).eye(0);
-  const double reach_mm = 1.0 + cut.removal_radius_mm + 0.1;
+  // The gel is aspirated in whole triangles (core/topology/vitrector.hpp): the patch reaches as far as
+  // the farthest corner of a triangle that went.
+  double reach_mm = 0.0;
+  for (const core::TriangleId id : ids0) {
+    if (g1.triangle_alive(id.index) && g1.triangle_id(id.index).generation == id.generation) continue;
+    for (const core::Vec3& p : triangles0[id.index]) reach_mm = std::max(reach_mm, (p - target).norm());
+  }
+  ASSERT_GT(reach_mm, 0.0);
   const vr::Vec2 centre = vt::project_to_pixel(before, 0, to_r(target), kW, kH);
   float reach_px = 0.0f;
   for (int k = 0; k < 16; ++k) {
