@@ -95,6 +95,7 @@ CaseProgress::CaseProgress(const TissueWorld& world, MetricsCase c, ProgressOpti
     switch (spec.kind) {
       case CriterionKind::kGelRemoved:
         if (case_.gel == kNone) throw InvalidArgument("metrics: gel_removed needs a gel");
+        if (!spec.target.empty() && spec.target != "core") throw InvalidArgument("metrics: gel_removed's target is \"core\" or none");
         break;
       case CriterionKind::kMembraneRemoved:
       case CriterionKind::kMembraneReleased:
@@ -157,12 +158,7 @@ CaseProgress::CaseProgress(const TissueWorld& world, MetricsCase c, ProgressOpti
     scale_start_.push_back(start);
   }
 
-  if (case_.gel != kNone) {
-    const Surface& g = world.surface(case_.gel);
-    for (std::uint32_t v = 0; v < g.vertex_slots(); ++v) {
-      if (g.vertex_alive(v)) gel_start_.push_back(g.vertex_id(v));
-    }
-  }
+  if (case_.gel != kNone) gel_start_ = gel_area(world);
   // Membrane pieces that no attachment holds at the start (islands of a coarse mesh) are not the
   // surgeon's work: membrane_freed counts from what was free then.
   membrane_free_start_.assign(case_.membranes.size(), 0.0);
@@ -318,8 +314,10 @@ void CaseProgress::evaluate(const TissueWorld& world, const InstrumentSystem* in
     const std::uint32_t item = item_[i];
     switch (p.kind) {
       case CriterionKind::kGelRemoved: {
-        const TissueProgress t = tissue(world);
-        p.value = t.gel_vertices_initial ? static_cast<double>(t.gel_vertices_removed) / t.gel_vertices_initial : 0.0;
+        const GelArea now = gel_area(world);
+        const bool core = p.target == "core";
+        const double start = core ? gel_start_.core_mm2 : gel_start_.all_mm2;
+        p.value = start > 0.0 ? std::clamp(1.0 - (core ? now.core_mm2 : now.all_mm2) / start, 0.0, 1.0) : 0.0;
         break;
       }
       case CriterionKind::kMembraneRemoved: {
@@ -358,14 +356,33 @@ void CaseProgress::evaluate(const TissueWorld& world, const InstrumentSystem* in
   }
 }
 
+CaseProgress::GelArea CaseProgress::gel_area(const TissueWorld& world) const {
+  // By rest area, not by vertices: the vitrector's clipping inserts vertices and its aspiration takes
+  // whole triangles, and a count of vertices would depend on the mesh's resolution. Where a piece of
+  // gel lies is judged at rest (its place in the eye before anything pulled it), so gel drawn toward
+  // the port does not change sides. Recomputed only when the gel's topology changed.
+  const Surface& g = world.surface(case_.gel);
+  if (g.topology_version() == gel_now_version_) return gel_now_;
+  GelArea a;
+  for (std::uint32_t t = 0; t < g.triangle_slots(); ++t) {
+    if (!g.triangle_alive(t)) continue;
+    const auto tv = g.triangle_vertices(t);
+    const Vec3 centroid = (g.rest_position(tv[0]) + g.rest_position(tv[1]) + g.rest_position(tv[2])) / 3.0;
+    const double area = g.triangle_rest_area(t);
+    a.all_mm2 += area;
+    const bool central = world.wall().clearance(centroid) > kCoreGelDepth_mm && centroid.z() < world.wall().center().z();
+    if (central) a.core_mm2 += area;
+  }
+  gel_now_ = a;
+  gel_now_version_ = g.topology_version();
+  return a;
+}
+
 TissueProgress CaseProgress::tissue(const TissueWorld& world) const {
   TissueProgress t;
   if (case_.gel != kNone) {
-    const Surface& g = world.surface(case_.gel);
-    t.gel_vertices_initial = static_cast<std::uint32_t>(gel_start_.size());
-    for (const VertexId v : gel_start_) {
-      if (!g.is_current(v)) ++t.gel_vertices_removed;
-    }
+    t.gel_area_initial_mm2 = gel_start_.all_mm2;
+    t.gel_area_removed_mm2 = std::max(0.0, gel_start_.all_mm2 - gel_area(world).all_mm2);
   }
   for (std::size_t m = 0; m < case_.membranes.size(); ++m) {
     const MetricsCase::Membrane& mb = case_.membranes[m];

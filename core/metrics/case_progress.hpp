@@ -5,7 +5,10 @@
 // case's start), from public state of the world and the instruments; nothing here is stepped.
 //
 // The measures (why each is what it is is in core/metrics/README.md):
-//   gel_removed        fraction of the gel's vertices at the start that no longer exist
+//   gel_removed        1 − gel rest area now / at the start; target "core": only the central gel,
+//                      more than kCoreGelDepth_mm inside the wall and behind the globe's equator at
+//                      rest (the cortical shell on the retina and the peripheral gel toward the
+//                      vitreous base stay, as in a core vitrectomy)
 //   membrane_removed   1 − rest area now / rest area at the start
 //   membrane_released  fraction of the membrane's attachments broken or with an end cut away
 //   membrane_freed     fraction of the membrane's start area removed or in pieces that no holding
@@ -55,6 +58,13 @@ struct MetricsCase {
   static MetricsCase from_scene(const Scene& scene);
 };
 
+// gel_removed's "core": gel lying more than this inside the wall at rest, and behind the equator (the
+// plane through the globe's centre at right angles to the optical axis, eye frame z: anterior is +z).
+// The outer shell lies on the retina (the cortical vitreous); the next one in stands 2.5 mm inside it
+// (anatomy.gel_shell_spacing_mm). In front of the equator the shells run along the wall to the
+// vitreous base: peripheral gel, shaved in a later step, not part of a core vitrectomy.
+inline constexpr double kCoreGelDepth_mm = 1.0;
+
 struct ProgressOptions {
   double path_tolerance_mm = 0.25;  // a guide point counts as cut when a new edge passes this close
   double sample_spacing_mm = 0.05;  // guides are measured at points this far apart along their arc
@@ -73,8 +83,8 @@ struct CriterionProgress {
 };
 
 struct TissueProgress {
-  std::uint32_t gel_vertices_initial = 0;
-  std::uint32_t gel_vertices_removed = 0;  // of those at the start
+  double gel_area_initial_mm2 = 0.0;  // rest area, all the gel
+  double gel_area_removed_mm2 = 0.0;
   double membrane_area_initial_mm2 = 0.0;  // rest area, all membranes
   double membrane_area_removed_mm2 = 0.0;
   std::uint32_t membrane_attachments = 0;
@@ -124,7 +134,14 @@ class CaseProgress {
   std::vector<std::uint32_t> item_;          // per criterion: membrane / detachment / samples index
   std::vector<GuideSamples> samples_;
   std::vector<std::uint32_t> target_samples_;  // samples_ of the targets_reached criteria (covered = reached)
-  std::vector<VertexId> gel_start_;          // gel vertices at the start
+  // Gel rest area (all, core) at the start, and now with the gel's topology version it was taken at.
+  struct GelArea {
+    double all_mm2 = 0.0, core_mm2 = 0.0;
+  };
+  GelArea gel_area(const TissueWorld& world) const;
+  GelArea gel_start_;
+  mutable GelArea gel_now_;
+  mutable std::uint64_t gel_now_version_ = ~std::uint64_t{0};
   std::vector<double> membrane_area_start_;  // rest area per membrane at the start
   std::vector<double> scale_start_;          // per criterion (drained): the force scale at the start
   double lift_start_mm_ = 0.0;

@@ -188,6 +188,7 @@ void SceneDescription::validate() const {
     switch (c.kind) {
       case CriterionKind::kGelRemoved:
         if (anatomy.gel_shells == 0) throw InvalidArgument(w + "the scene has no gel");
+        if (!c.target.empty() && c.target != "core") throw InvalidArgument(w + "target must be \"core\" (the gel away from the retina) or absent");
         require_range(c.threshold, 0.0, 1.0, w + "threshold");
         break;
       case CriterionKind::kMembraneRemoved:

@@ -22,7 +22,7 @@ SceneDescription case_scene(bool gel) {
   SceneDescription d;
   d.name = "metrics";
   d.anatomy.retina_vertices = 6000;
-  d.anatomy.gel_shells = gel ? 1 : 0;
+  d.anatomy.gel_shells = gel ? 2 : 0;
   d.texture_size_px = 64;
   d.materials = default_materials();
   d.tears.push_back({"u", {60.0, 120.0}, 2.5, 3.5, 0.8});
@@ -47,7 +47,10 @@ SceneDescription case_scene(bool gel) {
                 {CriterionKind::kPathCut, "line", 0.8},       {CriterionKind::kLaserCoverage, "ring", 0.8},
                 {CriterionKind::kDrained, "fluid", 0.05},     {CriterionKind::kRetinaFlat, "", 0.3},
                 {CriterionKind::kTimeLimit, "", 60.0}};
-  if (gel) d.criteria.push_back({CriterionKind::kGelRemoved, "", 0.3});
+  if (gel) {
+    d.criteria.push_back({CriterionKind::kGelRemoved, "", 0.3});
+    d.criteria.push_back({CriterionKind::kGelRemoved, "core", 0.3});
+  }
   return d;
 }
 
@@ -127,33 +130,67 @@ TEST(Criteria, MembraneRemovedAndReleasedFollowTheVitrector) {
   }
 }
 
-TEST(Criteria, GelRemovedIsTheShareOfTheStartingGelVerticesGone) {
+// The gel's rest area from its triangles' rest corners (half the cross product), all of it or only
+// the triangles whose rest centroid lies more than `deeper_than` inside the wall (judged by the
+// wall's radius in that direction) and, when `posterior`, behind the globe's centre along z.
+double gel_rest_area(const TissueWorld& w, const Surface& g, double deeper_than, bool posterior = false) {
+  double sum = 0.0;
+  for (std::uint32_t t = 0; t < g.triangle_slots(); ++t) {
+    if (!g.triangle_alive(t)) continue;
+    const auto tv = g.triangle_vertices(t);
+    const Vec3 a = g.rest_position(tv[0]), b = g.rest_position(tv[1]), c = g.rest_position(tv[2]);
+    const Vec3 centroid = (a + b + c) / 3.0;
+    const Vec3 d = centroid - w.wall().center();
+    if (w.wall().radius_toward(d) - d.norm() <= deeper_than) continue;
+    if (posterior && d.z() >= 0.0) continue;
+    sum += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return sum;
+}
+
+const CriterionProgress& find_target(const std::vector<CriterionProgress>& all, CriterionKind k, const std::string& target) {
+  for (const auto& c : all) {
+    if (c.kind == k && c.target == target) return c;
+  }
+  ADD_FAILURE() << "no criterion " << to_string(k) << " " << target;
+  return all.front();
+}
+
+TEST(Criteria, GelRemovedIsTheShareOfTheGelRestAreaGoneAndCoreLeavesTheCorticalShell) {
   Scene scene = build(true);
   SessionMetrics m(scene, nullptr);
   Surface& gs = scene.world.surface(scene.gel);
-  // Reference: the vitrector takes the posterior half (z < 0): every vertex clearly behind the
-  // plane goes, none in front of it; those within a snap of the plane may stay.
-  std::uint32_t n = 0, behind = 0, clearly_behind = 0;
-  for (std::uint32_t v = 0; v < gs.vertex_slots(); ++v) {
-    if (!gs.vertex_alive(v)) continue;
-    ++n;
-    if (gs.position(v).z() < 0.0) ++behind;
-    if (gs.position(v).z() < -0.2) ++clearly_behind;
-  }
-  ASSERT_GT(clearly_behind, n / 5);
-  EXPECT_FALSE(find(m.criteria(), CriterionKind::kGelRemoved).met);
+  const double all0 = gel_rest_area(scene.world, gs, -1e9), core0 = gel_rest_area(scene.world, gs, kCoreGelDepth_mm, true);
+  // Two shells 2.5 mm apart: the core is the inner one's posterior part.
+  ASSERT_GT(core0, 0.1 * all0);
+  ASSERT_LT(core0, 0.4 * all0);
+  EXPECT_FALSE(find_target(m.criteria(), CriterionKind::kGelRemoved, "").met);
+  EXPECT_EQ(find_target(m.criteria(), CriterionKind::kGelRemoved, "core").value, 0.0);
+  // The vitrector clips away everything behind z = -4 mm: most of both shells' posterior parts.
   VitrectorSettings vs;
   vs.field_radius_mm = 20.0;
   vs.removal_radius_mm = 15.0;
   Vitrector v(gs, vs);
-  ASSERT_TRUE(v.set_pose(Vec3::Zero(), -Vec3::UnitZ()));
+  ASSERT_TRUE(v.set_pose(Vec3(0.0, 0.0, -4.0), -Vec3::UnitZ()));
   ASSERT_TRUE(v.cut_now().status);
-  const auto gel = find(m.criteria(), CriterionKind::kGelRemoved);
-  EXPECT_GE(gel.value, static_cast<double>(clearly_behind) / n);
-  EXPECT_LE(gel.value, static_cast<double>(behind) / n);
-  EXPECT_TRUE(gel.met);
-  EXPECT_EQ(m.tissue().gel_vertices_initial, n);
+  const double all1 = gel_rest_area(scene.world, gs, -1e9), core1 = gel_rest_area(scene.world, gs, kCoreGelDepth_mm, true);
+  ASSERT_LT(all1, 0.9 * all0);
+  const auto& all = find_target(m.criteria(), CriterionKind::kGelRemoved, "");
+  const auto& core = find_target(m.criteria(), CriterionKind::kGelRemoved, "core");
+  EXPECT_NEAR(all.value, 1.0 - all1 / all0, 1e-9);
+  EXPECT_NEAR(core.value, 1.0 - core1 / core0, 1e-9);
+  EXPECT_GT(core.value, 0.3);  // a part of the core, not all of it
+  EXPECT_LT(core.value, 0.95);
+  EXPECT_TRUE(all.met);
+  EXPECT_TRUE(core.met);
+  EXPECT_NEAR(m.tissue().gel_area_removed_mm2, all0 - all1, 1e-6 * all0);
   EXPECT_TRUE(check_surface(gs).ok());
+}
+
+TEST(Criteria, GelRemovedCoreIsRefusedWithAnyOtherTarget) {
+  SceneDescription d = case_scene(true);
+  d.criteria.push_back({CriterionKind::kGelRemoved, "cortex", 0.3});
+  EXPECT_THROW((void)build_scene(d, {false, false}), InvalidArgument);
 }
 
 TEST(Criteria, PathCutIsTheShareOfTheGuideAlongANewCut) {
