@@ -226,16 +226,20 @@ TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilIt
   const telemetry::Recording rec = telemetry::read_recording(config.record_path);
   ASSERT_EQ(rec.verdict, telemetry::RecordingVerdict::Complete) << rec.describe();
   std::int64_t first_same_us = -1, stuck_us = -1, up_us = -1;
-  const telemetry::DeviceInput* prev = nullptr;
+  const telemetry::TrackerSample* prev = nullptr;
+  std::int64_t prev_us = -1;
   for (const auto& in : rec.inputs) {
-    if (in.device_kind == static_cast<std::int8_t>(rig::InputKind::Tracker)) {
-      const bool same = prev && std::memcmp(prev->values, in.values, sizeof(double) * 7) == 0;
-      if (same && first_same_us < 0 && stuck_us < 0) first_same_us = prev->host_time_us;
+    if (const auto* t = std::get_if<telemetry::TrackerSample>(&in.what)) {
+      // The pose's bits: tip and orientation.
+      const bool same = prev && std::memcmp(prev->tip_mm.data(), t->tip_mm.data(), sizeof t->tip_mm) == 0 &&
+                        std::memcmp(prev->q_wxyz.data(), t->q_wxyz.data(), sizeof t->q_wxyz) == 0;
+      if (same && first_same_us < 0 && stuck_us < 0) first_same_us = prev_us;
       if (!same && stuck_us < 0) first_same_us = -1;  // a run that ended was noise, not the fault
-      prev = &in;
-    } else if (in.device_kind == rig::kLinkKind && in.channel == 0) {
-      if (in.values[0] == static_cast<double>(rig::LinkInput::Stuck) && stuck_us < 0) stuck_us = in.host_time_us;
-      if (in.values[0] == static_cast<double>(rig::LinkInput::Up) && stuck_us >= 0) up_us = in.host_time_us;
+      prev = t;
+      prev_us = in.host_time_us;
+    } else if (const auto* link = std::get_if<telemetry::LinkChange>(&in.what); link && in.channel == 0) {
+      if (link->event == telemetry::LinkEvent::Stuck && stuck_us < 0) stuck_us = in.host_time_us;
+      if (link->event == telemetry::LinkEvent::Up && stuck_us >= 0) up_us = in.host_time_us;
     }
   }
   ASSERT_GE(first_same_us, 0) << "the fault's identical poses are in the recording";
@@ -347,7 +351,7 @@ void rewrite_end_marker(const std::string& from, const std::string& to, double s
     lcm::LogEvent copy = *ev;
     vitreo_lcm::device_input_t m;
     if (ev->channel == telemetry::kChanRecInput && m.decode(ev->data, 0, ev->datalen) == ev->datalen &&
-        m.device_kind == rig::kSessionEndKind) {
+        m.device_kind == static_cast<std::int8_t>(telemetry::InputKind::SessionEnd)) {
       m.values[0] = steps;
       buf.resize(static_cast<std::size_t>(m.getEncodedSize()));
       ASSERT_GT(m.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
@@ -455,15 +459,14 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   EXPECT_NEAR(static_cast<double>(scene.world.surface(scene.retina).vertex_count()), 1500.0, 300.0);
   EXPECT_TRUE(scene.settle.settled);
   // A tracked forceps tip inside the eye puts the forceps (not another tool) in through working_1.
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
   const core::Vec3 tip = c.tracker_ports[0].position_mm + 4.0 * (c.focus_mm - c.tracker_ports[0].position_mm).normalized();
-  in.values[0] = tip.x(); in.values[1] = tip.y(); in.values[2] = tip.z();
-  in.values[3] = 1.0;   // q w
-  in.values[8] = 1.0;   // quality
-  in.values[9] = 0.0;   // instrument id: the tool tracker
-  in.values[10] = 3.0;  // tool type
+  telemetry::TrackerSample sample;
+  sample.tip_mm = {tip.x(), tip.y(), tip.z()};
+  sample.quality = 1.0;
+  sample.instrument_id = 0;  // the tool tracker
+  sample.tool_type = 3;
+  telemetry::RecordedInput in;
+  in.what = sample;
   ASSERT_TRUE(model.apply(in));
   model.step();
   EXPECT_TRUE(model.simulation().instrument(0).input.present);
@@ -485,17 +488,15 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
   for (int i = 0; i < 20; ++i) model.step();
   EXPECT_EQ(model.world().state_hash(), moved) << "paused physics does not advance";
   ASSERT_TRUE(model.apply(command(4, 0)));  // resume
-  telemetry::DeviceInput reload;            // a reset reaches the model as the case reloaded
-  reload.device_kind = rig::kCaseKind;
-  reload.n_values = 1;
-  reload.values[0] = 0;
+  telemetry::RecordedInput reload;  // a reset reaches the model as the case reloaded
+  reload.what = telemetry::CaseSwitch{0};
   ASSERT_TRUE(model.apply(reload));
   EXPECT_EQ(model.world().state_hash(), fresh.world().state_hash()) << "reset returns the case to its start";
   EXPECT_EQ(model.case_loads(), 1u);
   ASSERT_TRUE(model.apply(command(9, 2.5)));
   for (int i = 0; i < 1000; ++i) model.step();  // the zoom motor gets there (ln 2.5 / 1.5 s)
   EXPECT_EQ(model.microscope().zoom(), 2.5);
-  telemetry::DeviceInput bad = command(9, std::nan(""));
+  telemetry::RecordedInput bad = command(9, std::nan(""));
   EXPECT_FALSE(model.apply(bad));
   model.step();
   EXPECT_EQ(model.microscope().zoom(), 2.5);
@@ -672,10 +673,8 @@ TEST(PhysicsSide, InstallingAPreparedCaseCapturingTheViewAndASnapshotDoNotAlloca
   runtime::TripleBuffer<rig::ViewSnapshot> views;
   model.step();
   std::unique_ptr<rig::PreparedCase> next = loader.load_now(1);  // the loader thread's work
-  telemetry::DeviceInput switch_input;
-  switch_input.device_kind = rig::kCaseKind;
-  switch_input.n_values = 1;
-  switch_input.values[0] = 1;
+  telemetry::RecordedInput switch_input;
+  switch_input.what = telemetry::CaseSwitch{1};
 
   // What physics does at a step boundary: capture (three slots, each sized for the case on first use).
   g_allocations = 0;
