@@ -94,6 +94,115 @@ TEST(RigSession, ARecordedSessionReplaysToTheSameState) {
   std::filesystem::remove(config.record_path);
 }
 
+// Issue 16: the recording's inputs, read back not through vitreo's reader but with LCM's own log
+// reader and lcm-gen's device_input_t, carry the kind codes and the value layout RECORDING.md
+// documents — a session with a tracker, pedals and the eye fixture, operator commands (zoom, pan,
+// reset) and the case switch the reset causes — and the session still replays to its state.
+TEST(RigSession, RecordedInputsCarryTheDocumentedKindsAndFields) {
+  auto config = small_session("kinds", 1500);
+  const char* kEyeball = "device eyeball\nrate_hz 250\nserial 3001\nkey 0 0 0 0 0 0\nkey 1000 6 -3 4 0 2\n";
+  config.devices.push_back(
+      {"eyeball", rig::DeviceRole::eyeball, "sim:eyeball?transport=pty&link=" + temp_path("kinds-eyeball"), 3, 0, 0, 0, kEyeball});
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string commands = "z 2.5\npan 1 -0.5\nr\n";
+  ASSERT_EQ(::write(fds[1], commands.data(), commands.size()), static_cast<ssize_t>(commands.size()));
+  ::close(fds[1]);
+  config.command_fd = fds[0];
+  std::FILE* echo = std::tmpfile();
+  ASSERT_NE(echo, nullptr);
+  config.command_echo = echo;
+  const rig::SessionSummary live = rig::run_session(config);
+  ::close(fds[0]);
+  std::fclose(echo);
+
+  lcm::LogFile log(config.record_path, "r");
+  ASSERT_TRUE(log.good());
+  std::map<int, int> per_kind;
+  std::vector<double> command_codes;
+  std::int64_t last_step = -1, end_step = -1;
+  bool end_seen_last = false;
+  auto unit = [](const std::vector<double>& v, std::size_t at) {
+    return std::abs(std::hypot(std::hypot(v[at], v[at + 1]), std::hypot(v[at + 2], v[at + 3])) - 1.0) < 1e-3;
+  };
+  auto in01 = [](double x) { return x >= 0.0 && x <= 1.0; };
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev != nullptr; ev = log.readNextEvent()) {
+    if (ev->channel != telemetry::kChanRecInput) continue;
+    vitreo_lcm::device_input_t m;
+    ASSERT_EQ(m.decode(ev->data, 0, ev->datalen), ev->datalen);
+    ++per_kind[m.device_kind];
+    end_seen_last = m.device_kind == 5;
+    last_step = m.step;
+    EXPECT_EQ(m.n_raw, 0) << "format 3 keeps no raw bytes";
+    const std::vector<double>& v = m.values;
+    switch (m.device_kind) {
+      case 1:  // tracker: tip x y z, q w x y z, actuation, quality, instrument id, tool type
+        ASSERT_EQ(m.n_values, 11);
+        EXPECT_EQ(m.device_id, 1);
+        EXPECT_TRUE(unit(v, 3)) << "the pose's quaternion";
+        EXPECT_TRUE(in01(v[7]) && in01(v[8]));
+        EXPECT_EQ(v[9], 0.0) << "the script's instrument 0";
+        EXPECT_EQ(v[10], 3.0) << "the script's tool 3";
+        break;
+      case 2:  // eye fixture: q w x y z, port count, inserted ×4, depth ×4
+        ASSERT_EQ(m.n_values, 13);
+        EXPECT_EQ(m.device_id, 3);
+        EXPECT_TRUE(unit(v, 0)) << "the globe's quaternion";
+        EXPECT_TRUE(v[4] >= 0.0 && v[4] <= 4.0);
+        for (std::size_t i = 5; i < 9; ++i) EXPECT_TRUE(v[i] == 0.0 || v[i] == 1.0);
+        break;
+      case 3:  // pedal: pedal id, axis count, axes ×4, switches
+        ASSERT_EQ(m.n_values, 7);
+        EXPECT_EQ(m.device_id, 2);
+        EXPECT_TRUE(v[0] == 0.0 || v[0] == 1.0);
+        EXPECT_TRUE(v[1] >= 0.0 && v[1] <= 4.0);
+        for (std::size_t i = 2; i < 6; ++i) EXPECT_TRUE(in01(v[i])) << v[i];
+        EXPECT_TRUE(v[6] >= 0.0 && v[6] <= 65535.0 && v[6] == std::floor(v[6]));
+        break;
+      case 4:  // link change: event (1 up, 2 lost, 3 stuck), device type (the device's own, or 0 before it said)
+        ASSERT_EQ(m.n_values, 2);
+        EXPECT_TRUE(v[0] >= 1.0 && v[0] <= 3.0);
+        EXPECT_TRUE(v[1] == 0.0 || v[1] == static_cast<double>(m.device_id)) << "ids 1 tracker, 2 pedals, 3 eyeball match the device types";
+        break;
+      case 5:  // session end: steps run = its step + 1
+        ASSERT_EQ(m.n_values, 1);
+        end_step = m.step;
+        EXPECT_EQ(v[0], static_cast<double>(m.step + 1));
+        break;
+      case 6:  // operator command: code, value, pan y
+        ASSERT_EQ(m.n_values, 3);
+        command_codes.push_back(v[0]);
+        if (v[0] == 9.0) {
+          EXPECT_EQ(v[1], 2.5);
+        }
+        if (v[0] == 10.0) {
+          EXPECT_TRUE(v[1] == 1.0 && v[2] == -0.5);
+        }
+        break;
+      case 7:  // case switch: index in the header's case list
+        ASSERT_EQ(m.n_values, 1);
+        EXPECT_EQ(v[0], 0.0);
+        break;
+      default: ADD_FAILURE() << "undocumented kind " << int{m.device_kind};
+    }
+  }
+  EXPECT_GT(per_kind[1], 500) << "the tracker streamed";
+  EXPECT_GT(per_kind[2], 100) << "the eye fixture streamed";
+  EXPECT_GT(per_kind[3], 100) << "the pedals streamed";
+  EXPECT_GE(per_kind[4], 3) << "each link came up";
+  EXPECT_EQ(per_kind[5], 1);
+  EXPECT_TRUE(end_seen_last) << "the session end is the last input";
+  EXPECT_EQ(end_step, 1499);
+  EXPECT_EQ(last_step, 1499);
+  EXPECT_EQ(command_codes, (std::vector<double>{9.0, 10.0, 5.0})) << "zoom, pan, reset in order";
+  EXPECT_EQ(per_kind[7], 1) << "the reset's case reload";
+
+  const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.verdict, telemetry::RecordingVerdict::Complete) << replay.verdict_text;
+  EXPECT_EQ(replay.state_hash, live.state_hash) << "replay diverged from the live session";
+  std::filesystem::remove(config.record_path);
+}
+
 TEST(RigSession, ScoresGoOutOnTelemetryAndTheReplayScoresTheSame) {
   auto config = small_session("scores", 1500);
   config.score_every_steps = 500;

@@ -373,6 +373,47 @@ TEST(Recording, RejectsFilesThatAreNotRecordings) {
   std::remove(future.c_str());
 }
 
+// Issue 16: format 3 types its inputs. A recording of format 2 (here a real one with its header's
+// version put back to 2, rewritten with LCM's own log reader and writer and lcm-gen's header type)
+// is refused with one line that names the file and both versions — never read as if it were 3.
+TEST(Recording, AVersion2RecordingIsRefusedNamingBothVersions) {
+  const std::string v3 = temp_path("rec-v3");
+  const std::string v2 = temp_path("rec-v2");
+  record(v3, 20);
+  {
+    lcm::LogFile in(v3, "r");
+    lcm::LogFile out(v2, "w");
+    ASSERT_TRUE(in.good() && out.good());
+    std::vector<std::uint8_t> buf;
+    for (const lcm::LogEvent* ev = in.readNextEvent(); ev != nullptr; ev = in.readNextEvent()) {
+      lcm::LogEvent copy = *ev;
+      if (ev->channel == kChanRecHeader) {
+        vitreo_lcm::recording_header_t h;
+        ASSERT_EQ(h.decode(ev->data, 0, ev->datalen), ev->datalen);
+        ASSERT_EQ(h.format_version, 3);
+        h.format_version = 2;
+        buf.resize(static_cast<std::size_t>(h.getEncodedSize()));
+        ASSERT_EQ(h.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+        copy.data = buf.data();
+        copy.datalen = static_cast<std::int32_t>(buf.size());
+      }
+      ASSERT_EQ(out.writeEvent(&copy), 0);
+    }
+  }
+  try {
+    read_recording(v2);
+    ADD_FAILURE() << "a version-2 recording was accepted";
+  } catch (const RecordingError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("recording format version 2, this vitreo reads 3"), std::string::npos) << what;
+    EXPECT_NE(what.find(v2), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+  EXPECT_EQ(read_recording(v3).verdict, RecordingVerdict::Complete) << "the same file at version 3 reads";
+  std::remove(v3.c_str());
+  std::remove(v2.c_str());
+}
+
 // Issue 20: a header whose first string length is INT_MIN made `vitreo --replay` segfault. Now it
 // is a recording that does not start with a header, said with the file's name.
 TEST(Recording, HeaderWithStringLengthIntMinIsRefusedWithTheFilesName) {
