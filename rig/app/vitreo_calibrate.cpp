@@ -155,19 +155,19 @@ int main(int argc, char** argv) {
         ++next_step;
       }
       hub.lockstep_deliver(k, kStepUs);
-      hub.take_new([&](const vitreo::telemetry::DeviceInput& in) {
+      hub.take_new([&](const vitreo::telemetry::RecordedInput& in) {
+        namespace tm = vitreo::telemetry;
         const std::string& name = name_of[in.device_id];
-        if (vitreo::rig::DecodedTracker t; vitreo::rig::decode_tracker(in, t)) {
-          rec.poses[name].push_back({t_s, t.pose.tip_mm, t.pose.orientation});
-        } else if (vitreo::rig::DecodedEyeball e; vitreo::rig::decode_eyeball(in, e)) {
-          rec.eyeball[name].push_back({t_s, e.orientation});
-        } else if (vitreo::rig::PedalReading p; vitreo::rig::decode_pedals(in, p)) {
-          rec.pedals[name].push_back({t_s, p.pedal_id, {p.axes[0], p.axes[1]}});
-        } else if (in.device_kind == vitreo::rig::kLinkKind && in.n_values >= 1 &&
-                   in.values[0] != static_cast<double>(vitreo::rig::LinkInput::Up)) {
+        if (const auto* t = std::get_if<tm::TrackerSample>(&in.what)) {
+          const vitreo::rig::TrackedPose pose = vitreo::rig::tracked_pose(*t);
+          rec.poses[name].push_back({t_s, pose.tip_mm, pose.orientation});
+        } else if (const auto* e = std::get_if<tm::EyeFixtureSample>(&in.what)) {
+          rec.eyeball[name].push_back({t_s, vitreo::rig::fixture_orientation(*e)});
+        } else if (const auto* p = std::get_if<tm::PedalSample>(&in.what)) {
+          rec.pedals[name].push_back({t_s, p->pedal_id, {p->axes[0], p->axes[1]}});
+        } else if (const auto* l = std::get_if<tm::LinkChange>(&in.what); l && l->event != tm::LinkEvent::Up) {
           char b[160];
-          std::snprintf(b, sizeof b, "%s: link %s at %.3f s", name.c_str(),
-                        in.values[0] == static_cast<double>(vitreo::rig::LinkInput::Lost) ? "lost" : "stuck", t_s);
+          std::snprintf(b, sizeof b, "%s: link %s at %.3f s", name.c_str(), l->event == tm::LinkEvent::Lost ? "lost" : "stuck", t_s);
           link_events.emplace_back(b);
           std::printf("[%5.1f s] %s\n", t_s, b);
         }

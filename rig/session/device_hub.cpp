@@ -37,23 +37,20 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
     if (mode_ == HubMode::lockstep && !d->driver->simulated_peer())
       throw std::runtime_error("device " + spec.name + " (" + spec.uri + "): a lockstep session needs simulated devices (sim:...); a real device runs on its own clock");
     Device* raw = d.get();
-    // A link change as a recorded input: values[0] the LinkInput, values[1] the device's type (from
-    // its DEVICE_INFO, 0 before one came) — only a tracker's link freezes an instrument.
-    auto link_input = [this, raw](LinkInput state) {
-      telemetry::DeviceInput link;
+    // A link change as a recorded input, with the device's type (from its DEVICE_INFO, 0 before one
+    // came): only a tracker's link freezes an instrument.
+    auto link_input = [this, raw](telemetry::LinkEvent event) {
+      telemetry::RecordedInput link;
       link.device_id = raw->spec.device_id;
-      link.device_kind = kLinkKind;
       link.channel = raw->spec.channel;
       link.host_time_us = static_cast<std::int64_t>(clock_.now_us());
       link.sequence = raw->sequence++;
-      link.n_values = 2;
-      link.values[0] = static_cast<double>(state);
       const auto& session = raw->driver->session();
-      link.values[1] = session.has_device_info() ? static_cast<double>(session.device_info().device_type) : 0.0;
+      link.what = telemetry::LinkChange{event, session.has_device_info() ? session.device_info().device_type : std::uint8_t{0}};
       if (!links_.try_push(link)) spdlog::warn("device {}: link-change queue full, change dropped", raw->spec.name);
     };
     d->driver->session().set_on_sample([this, raw, link_input](const drivers::Sample& s) {
-      telemetry::DeviceInput in = encode_sample(s, raw->spec.device_id, raw->sequence++);
+      telemetry::RecordedInput in = encode_sample(s, raw->spec.device_id, raw->sequence++);
       in.channel = raw->spec.channel;
       // A stuck sensor (the driver's verdict: bit-identical for 50 ms of device time) is reported at
       // once, ahead of its sample: physics freezes the instrument as if the tracker were lost.
@@ -62,7 +59,7 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
         raw->stuck_reported = stuck;
         if (stuck) spdlog::warn("device {}: sensor stuck (identical samples for 50 ms) — its instrument is frozen", raw->spec.name);
         else spdlog::info("device {}: sensor moving again", raw->spec.name);
-        link_input(stuck ? LinkInput::Stuck : LinkInput::Up);
+        link_input(stuck ? telemetry::LinkEvent::Stuck : telemetry::LinkEvent::Up);
       }
       raw->latest.write_slot() = in;
       raw->latest.publish();
@@ -73,7 +70,7 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
       const bool down = to == drivers::LinkState::lost;
       if (!up && !down) return;
       raw->stuck_reported = false;  // a new link starts unstuck (the driver forgets too)
-      link_input(up ? LinkInput::Up : LinkInput::Lost);
+      link_input(up ? telemetry::LinkEvent::Up : telemetry::LinkEvent::Lost);
     });
     devices_.push_back(std::move(d));
   }

@@ -66,11 +66,11 @@ class DeviceHub {
   // since the last call, and every link change since the last call.
   template <class F>
   void take_new(F&& f) {
-    telemetry::DeviceInput link;
+    telemetry::RecordedInput link;
     while (links_.try_pop(link)) f(link);
     for (auto& d : devices_) {
       if (!d->latest.update()) continue;
-      const telemetry::DeviceInput& in = d->latest.read_slot();
+      const telemetry::RecordedInput& in = d->latest.read_slot();
       if (in.sequence == d->last_taken) continue;
       d->last_taken = in.sequence;
       f(in);
@@ -119,7 +119,7 @@ class DeviceHub {
   struct Device {
     DeviceSpec spec;
     std::unique_ptr<drivers::Device> driver;
-    runtime::TripleBuffer<telemetry::DeviceInput> latest;
+    runtime::TripleBuffer<telemetry::RecordedInput> latest;
     std::int64_t sequence = 0;
     std::int64_t last_taken = -1;
     std::atomic<int> plug_request{0};  // +1 plug, -1 unplug
@@ -149,7 +149,7 @@ class DeviceHub {
   };
 
   std::vector<std::unique_ptr<Device>> devices_;
-  runtime::SpscRing<telemetry::DeviceInput> links_{256};
+  runtime::SpscRing<telemetry::RecordedInput> links_{256};
   telemetry::TelemetrySource* status_out_;
   HubMode mode_;
   HubClock clock_;

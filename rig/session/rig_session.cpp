@@ -99,19 +99,15 @@ telemetry::Event instrument_event(const core::InstrumentEvent& e, std::int64_t s
 }
 
 // Recorded at the last step so a replay knows how long the session ran.
-telemetry::DeviceInput session_end_marker(std::uint64_t steps) {
-  telemetry::DeviceInput in;
-  in.device_kind = kSessionEndKind;
-  in.n_values = 1;
-  in.values[0] = static_cast<double>(steps);
+telemetry::RecordedInput session_end_marker(std::uint64_t steps) {
+  telemetry::RecordedInput in;
+  in.what = telemetry::SessionEnd{static_cast<std::int64_t>(steps)};
   return in;
 }
 
-telemetry::DeviceInput case_input(int index) {
-  telemetry::DeviceInput in;
-  in.device_kind = kCaseKind;
-  in.n_values = 1;
-  in.values[0] = static_cast<double>(index);
+telemetry::RecordedInput case_input(int index) {
+  telemetry::RecordedInput in;
+  in.what = telemetry::CaseSwitch{index};
   return in;
 }
 
@@ -121,17 +117,14 @@ std::string hex(std::uint64_t v) {
   return buf;
 }
 
-telemetry::DeviceInput command_input(const telemetry::AcceptedCommand& cmd) {
-  telemetry::DeviceInput in;
-  in.device_kind = kCommandKind;
+telemetry::RecordedInput command_input(const telemetry::AcceptedCommand& cmd) {
+  telemetry::RecordedInput in;
   in.sequence = cmd.seq;
-  in.n_values = 2;
-  in.values[0] = static_cast<double>(static_cast<int>(cmd.code));
-  in.values[1] = cmd.value;
-  if (cmd.code == telemetry::CommandCode::Pan) {  // y travels as text (validated by the server)
-    in.n_values = 3;
-    in.values[2] = std::strtod(cmd.arg, nullptr);
-  }
+  telemetry::OperatorCommand c;
+  c.code = static_cast<std::int8_t>(cmd.code);
+  c.value = cmd.value;
+  if (cmd.code == telemetry::CommandCode::Pan) c.pan_y_mm = std::strtod(cmd.arg, nullptr);  // y travels as text (validated by the server)
+  in.what = c;
   return in;
 }
 
@@ -344,8 +337,8 @@ SessionSummary run_session(const SessionConfig& config) {
     const int stop = config.stop ? config.stop->load(std::memory_order_relaxed) : 0;
     const bool last = k + 1 == config.steps || stop != 0;
     if (config.on_step) config.on_step(k, hub);
-    auto consume = [&](const telemetry::DeviceInput& in) {
-      telemetry::DeviceInput stamped = in;
+    auto consume = [&](const telemetry::RecordedInput& in) {
+      telemetry::RecordedInput stamped = in;
       stamped.step = step;
       if (recorder) recorder->push(stamped);
       model.apply(stamped);
@@ -610,7 +603,7 @@ SessionSummary run_session(const SessionConfig& config) {
 }
 
 ReplaySummary replay_session(const std::string& path, const ModelConfig& base, bool real_time) {
-  const telemetry::Recording rec = telemetry::read_recording(path, &check_recorded_input);
+  const telemetry::Recording rec = telemetry::read_recording(path);
   // The cases as they were recorded: their texts are in the header, not read from scenes/.
   ModelConfig model_config = base;
   if (rec.header.config_name != "vitreo-cases") {
@@ -627,10 +620,10 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
                                     rec.header.snapshot_hash + " (a different build of the simulation?)");
   }
   for (const auto& in : rec.inputs) {
-    if (in.device_kind == kCaseKind && static_cast<int>(in.values[0]) >= model.case_count()) {
+    const auto* to = std::get_if<telemetry::CaseSwitch>(&in.what);
+    if (to && to->index >= model.case_count()) {
       throw telemetry::RecordingError(path + ": an input at step " + std::to_string(in.step) + " switches to case " +
-                                      std::to_string(static_cast<int>(in.values[0])) + " of a list of " +
-                                      std::to_string(model.case_count()));
+                                      std::to_string(to->index) + " of a list of " + std::to_string(model.case_count()));
     }
   }
   telemetry::InputCursor cursor(rec);
@@ -646,7 +639,7 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
   runtime::LoopConfig loop_config;
   loop_config.period_ns = rec.header.step_period_us * 1000LL;
   runtime::FixedStepLoop loop(clock, loop_config, [&](std::uint64_t k, double) {
-    cursor.feed_through_step(static_cast<std::int64_t>(k), [&](const telemetry::DeviceInput& in) {
+    cursor.feed_through_step(static_cast<std::int64_t>(k), [&](const telemetry::RecordedInput& in) {
       model.apply(in);
       ++inputs;
     });

@@ -112,7 +112,7 @@ struct SessionSummary {
 //
 // Operator commands (LCM VITREO_COMMAND): next/previous case and reset ask the loader thread for a
 // case; it is built there (from the cache folder when it has the settled start) and installed by
-// physics at the next step boundary with one pointer move — recorded as a kCaseKind input, so a
+// physics at the next step boundary with one pointer move — recorded as a CaseSwitch input, so a
 // replay switches at the same step. Save snapshot copies the world into a preallocated buffer at
 // the step boundary; a writer thread stores it atomically as <snapshot_dir>/NAME.snapshot.
 SessionSummary run_session(const SessionConfig& config);

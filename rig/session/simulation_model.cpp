@@ -4,8 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include "core/common/state_hasher.hpp"
+#include "rig/telemetry/commands.hpp"
+#include "rig/telemetry/input_codec.hpp"
 
 namespace vitreo::rig {
 
@@ -53,97 +57,120 @@ int SimulationModel::selected_tool() const {
   return static_cast<int>(pedals_.controls().instrument_changes % n);
 }
 
-bool SimulationModel::apply(const telemetry::DeviceInput& in) {
-  for (std::uint8_t i = 0; i < in.n_values && i < telemetry::DeviceInput::kMaxValues; ++i) {
-    if (!std::isfinite(in.values[i])) {
+bool SimulationModel::apply(const telemetry::RecordedInput& in) {
+  // A value that is not a finite number changes nothing (a recording's reader refuses one outright;
+  // a live device's driver range-checks its frames, so none should arrive).
+  double values[telemetry::kMaxInputValues];
+  const std::size_t n = telemetry::input_values(in.what, values);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(values[i])) {
       ++refused_;
       return false;
     }
   }
-  bool ok = false;
-  if (in.device_kind == kSessionEndKind) {
-    ok = true;
-  } else if (in.device_kind == kCaseKind && in.n_values >= 1) {
-    const int index = static_cast<int>(in.values[0]);
-    if (index >= 0 && index < case_count()) {
-      if (staged_ && staged_->index == index) {
-        install(std::move(staged_));
-      } else {
-        install(prepare_case(config_.cases, index, config_.load));
-      }
-      ok = true;
-    }
-  } else if (in.device_kind == kCommandKind && in.n_values >= 2) {
-    ok = true;
-    // Codes follow telemetry::CommandCode. Case changes, reset and snapshots are carried out by the
-    // session (a case is loaded off the physics thread; its arrival is a kCaseKind input).
-    switch (static_cast<int>(in.values[0])) {
-      case 3: paused_ = true; break;   // Pause
-      case 4: paused_ = false; break;  // Resume
-      case 5: ++resets_; break;        // Reset: requested here, the reload arrives as kCaseKind
-      case 7: wireframe_ = !wireframe_; break;
-      case 8: labels_ = !labels_; break;
-      case 9: microscope_.set_zoom(in.values[1]); break;
-      case 10: microscope_.pan_to(core::Vec2(in.values[1], in.n_values >= 3 ? in.values[2] : 0.0)); break;
-      case 11: microscope_.set_focus(in.values[1]); break;
-      case 12: flat_shading_ = !flat_shading_; break;
-      case 13: microscope_.toggle_wide_angle(); break;
-      case 14: microscope_.toggle_reinverter(); break;
-      // The laser's settings, held to the commands' ranges here too (a recording could say anything).
-      case 15: ok = laser_power_in_range(in.values[1]); if (ok) laser_.power_mw = in.values[1]; break;
-      case 16: ok = laser_duration_in_range(in.values[1]); if (ok) laser_.duration_ms = in.values[1]; break;
-      default: break;
-    }
-  } else if (in.device_kind == kLinkKind && in.n_values >= 1) {
-    // Which instrument a tracker link carries is its channel; the pedals' and the fixture's links
-    // freeze no instrument (values[1]: the device's type, 1 a tracker; absent in older recordings).
-    const bool tracker = in.n_values < 2 || in.values[1] == 1.0;
-    if (tracker && in.channel >= 0 && in.channel < static_cast<int>(instruments_.size())) {
-      const int state = static_cast<int>(in.values[0]);
-      instruments_[static_cast<std::size_t>(in.channel)].frozen =
-          state == static_cast<int>(LinkInput::Lost) || state == static_cast<int>(LinkInput::Stuck);
-    }
-    ok = true;
-  } else if (DecodedTracker t; decode_tracker(in, t)) {
-    if (t.instrument_id >= 0 && t.instrument_id < kTrackedInstruments) {
-      InstrumentSlot& slot = instruments_[static_cast<std::size_t>(t.instrument_id)];
-      if (!slot.frozen) {
-        InstrumentPose pose;
-        // In the fixture frame: the instrument system applies the eye's rotation itself.
-        const std::size_t i = static_cast<std::size_t>(t.instrument_id);
-        const Port& port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[t.instrument_id];
-        ok = map_through_port(t.pose, port, core::Quat::Identity(), config_.calibration[i], pose);
-        if (ok) {
-          slot.present = true;
-          slot.port = case_->tracker_port_ids[t.instrument_id];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
-          slot.tool_type = t.tool_type;
-          slot.pose = pose;
-        }
-      } else {
-        ok = true;  // a frozen instrument ignores its (late) samples
-      }
-    }
-  } else if (PedalReading p; decode_pedals(in, p)) {
-    const SurgicalControls before = pedals_.controls();
-    ok = pedals_.apply(p);
-    // The pedal's zoom and focus are targets for the microscope's motors when they move (a command
-    // holds until the pedal moves again).
-    if (ok && pedals_.controls().zoom != before.zoom) microscope_.set_zoom(pedals_.controls().zoom);
-    if (ok && pedals_.controls().focus_offset_mm != before.focus_offset_mm) microscope_.set_focus(pedals_.controls().focus_offset_mm);
-  } else if (DecodedEyeball e; decode_eyeball(in, e)) {
-    const double n = e.orientation.coeffs().norm();
-    if (std::abs(n - 1.0) < 1e-3) {
-      // Relative to the calibrated rest reading; skipped when there is none, so uncalibrated
-      // sessions keep their bits.
-      eye_rotation_ = config_.eye_zero.coeffs() == core::Quat::Identity().coeffs()
-                          ? e.orientation.normalized()
-                          : (config_.eye_zero.conjugate() * e.orientation.normalized()).normalized();
-      eye_tracked_ = true;
-      ok = true;
-    }
-  }
+  const bool ok = std::visit(
+      [&](const auto& r) {
+        using T = std::decay_t<decltype(r)>;
+        if constexpr (std::is_same_v<T, telemetry::TrackerSample>) return apply_tracker(r);
+        else if constexpr (std::is_same_v<T, telemetry::EyeFixtureSample>) return apply_fixture(r);
+        else if constexpr (std::is_same_v<T, telemetry::PedalSample>) return apply_pedal(r);
+        else if constexpr (std::is_same_v<T, telemetry::LinkChange>) return apply_link(in.channel, r);
+        else if constexpr (std::is_same_v<T, telemetry::OperatorCommand>) return apply_command(r);
+        else if constexpr (std::is_same_v<T, telemetry::CaseSwitch>) return apply_case_switch(r);
+        else return std::is_same_v<T, telemetry::SessionEnd>;  // marks the length; changes nothing
+      },
+      in.what);
   ok ? ++applied_ : ++refused_;
   return ok;
+}
+
+bool SimulationModel::apply_case_switch(const telemetry::CaseSwitch& c) {
+  if (c.index < 0 || c.index >= case_count()) return false;
+  if (staged_ && staged_->index == c.index) {
+    install(std::move(staged_));
+  } else {
+    install(prepare_case(config_.cases, c.index, config_.load));
+  }
+  return true;
+}
+
+bool SimulationModel::apply_command(const telemetry::OperatorCommand& c) {
+  // Case changes, reset and snapshots are carried out by the session (a case is loaded off the
+  // physics thread; its arrival is a CaseSwitch).
+  using telemetry::CommandCode;
+  switch (static_cast<CommandCode>(c.code)) {
+    case CommandCode::Pause: paused_ = true; break;
+    case CommandCode::Resume: paused_ = false; break;
+    case CommandCode::Reset: ++resets_; break;  // requested here, the reload arrives as a CaseSwitch
+    case CommandCode::ToggleWireframe: wireframe_ = !wireframe_; break;
+    case CommandCode::ToggleLabels: labels_ = !labels_; break;
+    case CommandCode::Zoom: microscope_.set_zoom(c.value); break;
+    case CommandCode::Pan: microscope_.pan_to(core::Vec2(c.value, c.pan_y_mm)); break;
+    case CommandCode::Focus: microscope_.set_focus(c.value); break;
+    case CommandCode::ToggleShading: flat_shading_ = !flat_shading_; break;
+    case CommandCode::ToggleWideAngle: microscope_.toggle_wide_angle(); break;
+    case CommandCode::ToggleReinverter: microscope_.toggle_reinverter(); break;
+    // The laser's settings, held to the commands' ranges here too (a recording could say anything).
+    case CommandCode::LaserPower:
+      if (!laser_power_in_range(c.value)) return false;
+      laser_.power_mw = c.value;
+      break;
+    case CommandCode::LaserDuration:
+      if (!laser_duration_in_range(c.value)) return false;
+      laser_.duration_ms = c.value;
+      break;
+    default: break;
+  }
+  return true;
+}
+
+bool SimulationModel::apply_link(std::int32_t channel, const telemetry::LinkChange& link) {
+  // Which instrument a tracker link carries is its channel; the pedals' and the fixture's links
+  // freeze no instrument.
+  constexpr std::uint8_t kTrackerDevice = 1;  // PROTOCOL.md's device type of a tracker
+  if (link.device_type == kTrackerDevice && channel >= 0 && channel < static_cast<int>(instruments_.size())) {
+    instruments_[static_cast<std::size_t>(channel)].frozen =
+        link.event == telemetry::LinkEvent::Lost || link.event == telemetry::LinkEvent::Stuck;
+  }
+  return true;
+}
+
+bool SimulationModel::apply_tracker(const telemetry::TrackerSample& t) {
+  if (t.instrument_id >= kTrackedInstruments) return false;
+  InstrumentSlot& slot = instruments_[t.instrument_id];
+  if (slot.frozen) return true;  // a frozen instrument ignores its (late) samples
+  InstrumentPose pose;
+  // In the fixture frame: the instrument system applies the eye's rotation itself.
+  const std::size_t i = t.instrument_id;
+  const Port& port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[i];
+  if (!map_through_port(tracked_pose(t), port, core::Quat::Identity(), config_.calibration[i], pose)) return false;
+  slot.present = true;
+  slot.port = case_->tracker_port_ids[i];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
+  slot.tool_type = t.tool_type;
+  slot.pose = pose;
+  return true;
+}
+
+bool SimulationModel::apply_pedal(const telemetry::PedalSample& p) {
+  const SurgicalControls before = pedals_.controls();
+  const bool ok = pedals_.apply(pedal_reading(p));
+  // The pedal's zoom and focus are targets for the microscope's motors when they move (a command
+  // holds until the pedal moves again).
+  if (ok && pedals_.controls().zoom != before.zoom) microscope_.set_zoom(pedals_.controls().zoom);
+  if (ok && pedals_.controls().focus_offset_mm != before.focus_offset_mm) microscope_.set_focus(pedals_.controls().focus_offset_mm);
+  return ok;
+}
+
+bool SimulationModel::apply_fixture(const telemetry::EyeFixtureSample& e) {
+  const core::Quat orientation = fixture_orientation(e);
+  if (!(std::abs(orientation.coeffs().norm() - 1.0) < 1e-3)) return false;
+  // Relative to the calibrated rest reading; skipped when there is none, so uncalibrated sessions
+  // keep their bits.
+  eye_rotation_ = config_.eye_zero.coeffs() == core::Quat::Identity().coeffs()
+                      ? orientation.normalized()
+                      : (config_.eye_zero.conjugate() * orientation.normalized()).normalized();
+  eye_tracked_ = true;
+  return true;
 }
 
 core::StepReport SimulationModel::step() {

@@ -1,7 +1,7 @@
 #pragma once
 // The deterministic part of a session: the eye, and what the devices' inputs mean for it.
 //
-// Everything that changes the simulation enters through apply() as a recorded DeviceInput, and time
+// Everything that changes the simulation enters through apply() as a RecordedInput, and time
 // only through step(): live sessions and replays run this same code on the same inputs, which is
 // why a replay ends in the same state hash as the session it recorded.
 #include <array>
@@ -22,26 +22,6 @@
 #include "rig/session/laser_settings.hpp"
 
 namespace vitreo::rig {
-
-// A link's state as an input: a lost tracker must freeze its instrument in replay exactly when it
-// did live, so link changes are recorded like samples (device_kind kLinkKind, values[0] = state).
-// A stuck sensor (bit-identical poses for 50 ms) freezes its instrument the same way; Up ends both.
-inline constexpr std::int8_t kLinkKind = 4;
-enum class LinkInput : int { Up = 1, Lost = 2, Stuck = 3 };
-// The session's end, recorded at its last step (values[0] = steps run) so a replay knows its length.
-inline constexpr std::int8_t kSessionEndKind = 5;
-// An accepted operator command (values[0] = telemetry::CommandCode, values[1] = its value): pause,
-// reset, zoom or the laser's power change the session, so they are recorded and replayed like
-// device inputs.
-inline constexpr std::int8_t kCommandKind = 6;
-// A case (re)loaded at this step (values[0] = index in the case list): next/previous case and reset
-// take effect when the loader thread has the case ready, so the step they land on is recorded.
-inline constexpr std::int8_t kCaseKind = 7;
-
-// A recorded input's meaning, range-checked (telemetry::read_recording's InputCheck): a known kind,
-// finite values, a session-end marker that counts its own step, a case index and a command code that
-// exist. nullptr when fine, else why not.
-const char* check_recorded_input(const telemetry::DeviceInput& in) noexcept;
 
 struct ModelConfig {
   // The session's cases (scenes/*.toml as text, so a recording can carry them); first_case starts.
@@ -81,12 +61,12 @@ class SimulationModel {
   explicit SimulationModel(const ModelConfig& config);
   SimulationModel(const ModelConfig& config, std::unique_ptr<PreparedCase> first);
 
-  // Applies one recorded input. Returns false for an input it refuses (unknown kind, non-finite
-  // values, bad quaternion): the refusal is counted and the state is unchanged.
-  // A kCaseKind input installs the staged case when it is the one named, else loads it in place
+  // Applies one recorded input. Returns false for an input it refuses (non-finite values, bad
+  // quaternion, a case or setting out of range): the refusal is counted and the state is unchanged.
+  // A CaseSwitch installs the staged case when it is the one named, else loads it in place
   // (a replay), so both reach the same state.
-  bool apply(const telemetry::DeviceInput& in);
-  // Live sessions: a case prepared on another thread, installed by the next kCaseKind input for its
+  bool apply(const telemetry::RecordedInput& in);
+  // Live sessions: a case prepared on another thread, installed by the next CaseSwitch for its
   // index (wait-free: a pointer move). take_retired() hands back the case it replaced, so its memory
   // is freed off the physics thread.
   void stage(std::unique_ptr<PreparedCase> prepared) { staged_ = std::move(prepared); }
@@ -132,6 +112,13 @@ class SimulationModel {
   std::uint64_t state_hash() const;
 
  private:
+  // One per kind of input (apply() has checked that every value is finite).
+  bool apply_tracker(const telemetry::TrackerSample& t);
+  bool apply_fixture(const telemetry::EyeFixtureSample& e);
+  bool apply_pedal(const telemetry::PedalSample& p);
+  bool apply_link(std::int32_t channel, const telemetry::LinkChange& link);
+  bool apply_command(const telemetry::OperatorCommand& c);
+  bool apply_case_switch(const telemetry::CaseSwitch& c);
   ModelConfig config_;
   void install(std::unique_ptr<PreparedCase> c);
 

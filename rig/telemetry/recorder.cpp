@@ -78,7 +78,7 @@ void Recorder::write_event(const char* channel, std::int64_t timestamp_us) {
   crc_ = checksum_event(crc_, channel, buf_.data(), buf_.size());
 }
 
-void Recorder::write_input(const DeviceInput& in) {
+void Recorder::write_input(const RecordedInput& in) {
   encode(to_lcm(in), buf_);
   write_event(kChanRecInput, in.host_time_us + wall_minus_mono_us_);
   ++inputs_in_file_;
@@ -112,7 +112,7 @@ void Recorder::fail(const char* what) noexcept {
 }
 
 void Recorder::discard_queued() noexcept {
-  DeviceInput in;
+  RecordedInput in;
   while (ring_.try_pop(in)) ++lost_;
 }
 
@@ -123,7 +123,7 @@ std::size_t Recorder::pump(std::int64_t now_ns) noexcept {
   }
   std::size_t n = 0;
   try {
-    DeviceInput in;
+    RecordedInput in;
     auto checkpoint = [&] {
       write_check();
       flush();
@@ -148,7 +148,7 @@ std::size_t Recorder::pump(std::int64_t now_ns) noexcept {
 bool Recorder::finish(const RecordingEnd& end) noexcept {
   if (!log_) return false;
   try {
-    DeviceInput in;
+    RecordedInput in;
     while (ring_.try_pop(in)) write_input(in);
     vitreo_lcm::recording_end_t e;
     e.utime_us = wall_time_us();
@@ -174,7 +174,7 @@ bool Recorder::finish(const RecordingEnd& end) noexcept {
 void Recorder::close() noexcept {
   if (!log_) return;
   try {
-    DeviceInput in;
+    RecordedInput in;
     while (ring_.try_pop(in)) write_input(in);
     write_check();
     flush();

@@ -1,9 +1,10 @@
 #pragma once
 // Session recording and replay as standard LCM logs (lcm-logger / lcm-logplayer / lcm::LogFile read
 // them): a VITREO_REC_HEADER event (configuration, starting snapshot reference), one
-// VITREO_REC_INPUT event per raw device input sample in the order physics consumed them, a
-// VITREO_REC_CHECK event (running checksum) at every flush, and a VITREO_REC_END event (final state
-// hash, running checksum) when the session ends. RECORDING.md beside this file is the format.
+// VITREO_REC_INPUT event per input physics consumed (a typed RecordedInput, input_record.hpp) in the
+// order it consumed them, a VITREO_REC_CHECK event (running checksum) at every flush, and a
+// VITREO_REC_END event (final state hash, running checksum) when the session ends. RECORDING.md
+// beside this file is the format.
 //
 // Recorder: the physics thread pushes samples into a wait-free SPSC ring (dropped and counted when
 // full, never waited for); a recorder thread calls pump(), which appends them to the log and, at
@@ -28,6 +29,7 @@
 
 #include "rig/runtime/clock.hpp"
 #include "rig/runtime/spsc_ring.hpp"
+#include "rig/telemetry/input_record.hpp"
 
 namespace lcm {
 class LogFile;
@@ -35,26 +37,9 @@ class LogFile;
 
 namespace vitreo::telemetry {
 
-struct DeviceInput {
-  static constexpr std::size_t kMaxValues = 16;
-  static constexpr std::size_t kMaxRaw = 64;
-  std::int64_t host_time_us = 0;    // monotonic host clock at receive
-  std::int64_t device_time_us = 0;
-  std::int64_t step = 0;            // physics step that consumed it
-  std::int32_t device_id = 0;
-  std::int8_t device_kind = 0;
-  std::int32_t channel = 0;
-  std::int64_t sequence = 0;
-  std::uint8_t n_values = 0;
-  double values[kMaxValues] = {};
-  std::uint8_t n_raw = 0;
-  std::uint8_t raw[kMaxRaw] = {};
-};
-bool operator==(const DeviceInput& a, const DeviceInput& b) noexcept;  // bitwise on the used parts
-
 struct RecordingHeader {
   std::int64_t utime_us = 0;  // filled by the Recorder
-  std::int32_t format_version = 2;  // filled by the Recorder
+  std::int32_t format_version = 3;  // filled by the Recorder
   std::string software_version;
   std::string case_id;
   std::int32_t step_period_us = 1000;
@@ -90,7 +75,7 @@ class Recorder {
   Recorder& operator=(const Recorder&) = delete;
 
   // Producer (physics) thread: wait-free; false = dropped (counted).
-  bool push(const DeviceInput& in) noexcept { return ring_.try_push(in); }
+  bool push(const RecordedInput& in) noexcept { return ring_.try_push(in); }
 
   // Recorder thread: writes queued inputs; flushes when flush_interval has passed since the last
   // flush (now_ns on any monotonic clock). Returns inputs written. Never throws: a write error (disk
@@ -114,7 +99,7 @@ class Recorder {
 
  private:
   void write_event(const char* channel, std::int64_t timestamp_us);  // buf_ holds the encoded data
-  void write_input(const DeviceInput& in);
+  void write_input(const RecordedInput& in);
   void write_check();
   void flush();
   void fail(const char* what) noexcept;
@@ -123,7 +108,7 @@ class Recorder {
   std::string path_;
   RecorderConfig config_;
   std::unique_ptr<lcm::LogFile> log_;
-  runtime::SpscRing<DeviceInput> ring_;
+  runtime::SpscRing<RecordedInput> ring_;
   std::vector<std::uint8_t> buf_;
   std::int64_t wall_minus_mono_us_ = 0;  // maps monotonic sample times to log (wall) timestamps
   std::int64_t event_num_ = 0;
@@ -158,7 +143,7 @@ struct Recording {
   RecordingHeader header;
   // The inputs a replay may use: every one verified by a checksum, and — for a recording that is
   // not complete — only those of steps through `trusted_through_step`.
-  std::vector<DeviceInput> inputs;
+  std::vector<RecordedInput> inputs;
   RecordingVerdict verdict = RecordingVerdict::Complete;
   std::optional<RecordingEnd> end;          // present when the end event was read and verified
   std::int64_t trusted_through_step = -1;   // truncated/corrupted: replay steps 0..this; -1: none
@@ -173,13 +158,9 @@ struct Recording {
   std::string describe() const;
 };
 
-// Extra checks of a recorded input's meaning that the reader cannot know (the session's input
-// kinds): nullptr when fine, else why it is not (a static string). A refused input is a corruption.
-using InputCheck = const char* (*)(const DeviceInput& in);
-
 // Throws RecordingError when the file cannot be replayed at all (see above). Everything else — a
 // file cut short, bytes changed, data appended — comes back as a verdict with what is trustworthy.
-Recording read_recording(const std::string& path, InputCheck check = nullptr);
+Recording read_recording(const std::string& path);
 
 struct ReplayOptions {
   double speed = 1.0;  // 1 = real time, 2 = twice as fast; <= 0 = as fast as possible
@@ -188,7 +169,7 @@ struct ReplayOptions {
 // Feeds every input, in recorded order, to fn; waits on clock between inputs to keep their recorded
 // spacing / speed. Returns the number delivered.
 std::size_t replay(const Recording& rec, runtime::Clock& clock, ReplayOptions options,
-                   const std::function<void(const DeviceInput&)>& fn);
+                   const std::function<void(const RecordedInput&)>& fn);
 
 // Step-driven replay for a fixed-step loop: hands over, in order, the inputs recorded for steps up
 // to and including `step`.
@@ -207,7 +188,7 @@ class InputCursor {
   bool done() const noexcept { return next_ >= inputs_->size(); }
 
  private:
-  const std::vector<DeviceInput>* inputs_;
+  const std::vector<RecordedInput>* inputs_;
   std::size_t next_ = 0;
 };
 

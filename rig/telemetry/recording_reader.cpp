@@ -45,9 +45,10 @@ RecordingHeader read_header(LcmLogReader& log, const std::string& path, std::uin
   if (ev.channel != kChanRecHeader || decode_message(ev.data.data(), ev.data.size(), h) != DecodeError::None)
     fail(std::string("does not start with a ") + kChanRecHeader + " event");
   if (h.format_version != vitreo_lcm::recording_header_t::FORMAT_VERSION) {
-    fail("format version " + std::to_string(h.format_version) + "; this build reads version " +
+    // Both versions named: a person can tell at once whether the file or the build is the newer one.
+    fail("recording format version " + std::to_string(h.format_version) + ", this vitreo reads " +
          std::to_string(vitreo_lcm::recording_header_t::FORMAT_VERSION) +
-         (h.format_version == 1 ? " (version 1 has no checksums: replay it with the vitreo that made it)" : ""));
+         " (replay it with the vitreo that made it)");
   }
   if (h.step_period_us < 100 || h.step_period_us > 100'000)
     fail("step period of " + std::to_string(h.step_period_us) + " µs (0.1..100 ms)");
@@ -61,7 +62,7 @@ RecordingHeader read_header(LcmLogReader& log, const std::string& path, std::uin
 
 }  // namespace
 
-Recording read_recording(const std::string& path, InputCheck check) {
+Recording read_recording(const std::string& path) {
   LcmLogReader log;
   if (!log.open(path)) throw RecordingError("recording: " + log.problem());
   Recording rec;
@@ -71,7 +72,7 @@ Recording read_recording(const std::string& path, InputCheck check) {
   rec.events = 1;
 
   // Inputs read since the last verified checksum: they join rec.inputs when one vouches for them.
-  std::vector<DeviceInput> pending;
+  std::vector<RecordedInput> pending;
   std::uint64_t block_start = 0;  // first byte the next checksum vouches for (the first covers the header)
   std::int64_t inputs_total = 0, last_step = -1, blocks = 0;
   auto stop = [&](RecordingVerdict v, std::uint64_t at, std::string why) {
@@ -100,11 +101,10 @@ Recording read_recording(const std::string& path, InputCheck check) {
     ++rec.events;
     if (ev.channel == kChanRecInput) {
       vitreo_lcm::device_input_t m;
-      DeviceInput in;
+      RecordedInput in;
       const DecodeError de = decode_message(ev.data.data(), ev.data.size(), m);
       const char* why = de != DecodeError::None ? to_string(de) : from_lcm(m, in);
       if (!why && in.step < last_step) why = "its step is before the previous input's";
-      if (!why && check) why = check(in);
       if (why) {
         stop(RecordingVerdict::Corrupted, block_start, "input at byte " + std::to_string(at) + ": " + why);
         break;

@@ -73,13 +73,12 @@ void lcm_seeds(const fs::path& messages, const fs::path& command) {
   a.reason = "physics is not paused";
   write(messages, "ack", encoded(a, 1));
   vitreo_lcm::device_input_t in{};
+  in.device_kind = 3;  // a pedal (RECORDING.md)
   in.n_values = 7;
-  in.values = {1.5, -2.0, 12.0, 1.0, 0.0, 0.0, 0.0};
-  in.n_raw = 4;
-  in.raw = {1, 2, 3, 4};
+  in.values = {0.0, 2.0, 0.5, 0.25, 0.0, 0.0, 1.0};
   write(messages, "device_input", encoded(in, 2));
   vitreo_lcm::recording_header_t h{};
-  h.format_version = 2;
+  h.format_version = vitreo_lcm::recording_header_t::FORMAT_VERSION;
   h.step_period_us = 1000;
   h.case_id = "low_membrane_macula";
   h.config_name = "vitreo-cases";
@@ -152,25 +151,39 @@ void recording_seeds(const fs::path& dir, const std::string& scenes) {
     cfg.flush_interval_ns = 0;
     telemetry::Recorder rec(tmp.string(), h, cfg);
     std::int64_t step = 0;
-    auto push = [&](std::int8_t kind, std::vector<double> v, int channel = 0) {
-      telemetry::DeviceInput in;
+    // Every kind of input once or more (RECORDING.md's codes and fields).
+    auto push = [&](telemetry::InputPayload what) {
+      telemetry::RecordedInput in;
       in.host_time_us = 1000 + step * 1000;
       in.step = step;
-      in.device_kind = kind;
-      in.channel = channel;
-      in.n_values = static_cast<std::uint8_t>(v.size());
-      for (std::size_t k = 0; k < v.size(); ++k) in.values[k] = v[k];
+      in.what = what;
       rec.push(in);
       rec.pump(step * 1'000'000);
     };
-    push(7, {0});
-    for (; step < 12; ++step) push(1, {1.0 + 0.01 * static_cast<double>(step), 2, 3, 1, 0, 0, 0, 0.5, 0.98, 0, 3});
-    push(2, {0, 2, 0.5, 0, 0, 0, 1});
-    push(3, {1, 0, 0, 0, 3, 1, 0, 0, 0, 0, 0});
-    push(4, {3, 1});
-    push(6, {3, 0});
-    push(4, {1, 1});
-    push(5, {static_cast<double>(step + 1)});
+    push(telemetry::CaseSwitch{0});
+    for (; step < 12; ++step) {
+      telemetry::TrackerSample t;
+      t.tip_mm = {1.0 + 0.01 * static_cast<double>(step), 2, 3};
+      t.actuation = 0.5;
+      t.quality = 0.98;
+      t.tool_type = 3;
+      push(t);
+    }
+    telemetry::PedalSample p;
+    p.axis_count = 2;
+    p.axes[0] = 0.5;
+    p.switches = 1;
+    push(p);
+    telemetry::EyeFixtureSample e;
+    e.port_count = 4;
+    e.inserted = {false, true, false, true};
+    e.depth_mm = {0, 3, 0, 2.5};
+    push(e);
+    push(telemetry::LinkChange{telemetry::LinkEvent::Stuck, 1});
+    push(telemetry::OperatorCommand{3, 0.0, 0.0});
+    push(telemetry::OperatorCommand{10, 1.5, -0.5});
+    push(telemetry::LinkChange{telemetry::LinkEvent::Up, 1});
+    push(telemetry::SessionEnd{step + 1});
     rec.finish(telemetry::RecordingEnd{step + 1, 0x0123456789abcdefULL, "duration reached"});
   }
   const auto whole = slurp(tmp);

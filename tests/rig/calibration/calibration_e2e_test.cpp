@@ -134,7 +134,7 @@ TEST_F(CalibrationEndToEnd, RecoversEveryInjectedImperfectionWithinTheIssuesTole
 
 // Plays a tracker with the injected imperfections through a pty in lockstep, holding its tip at
 // `tip_eye` (eye frame), and returns the samples the driver decoded after the first 10 ms.
-std::vector<DecodedTracker> tracked_through_the_rig(const core::Vec3& tip_eye) {
+std::vector<TrackedPose> tracked_through_the_rig(const core::Vec3& tip_eye) {
   std::ifstream f(kSource + "/rig/config/sim/calibration-tracker.sim");
   std::string script((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   script.erase(script.find("key "));
@@ -149,11 +149,11 @@ std::vector<DecodedTracker> tracked_through_the_rig(const core::Vec3& tip_eye) {
   DeviceHub hub({d}, nullptr, HubMode::lockstep);
   hub.start();
   hub.lockstep_connect();
-  std::vector<DecodedTracker> samples;
+  std::vector<TrackedPose> samples;
   for (std::uint64_t k = 0; k < 110; ++k) {
     hub.lockstep_deliver(k, 1000);
-    hub.take_new([&](const telemetry::DeviceInput& in) {
-      if (DecodedTracker t; decode_tracker(in, t) && k >= 10) samples.push_back(t);
+    hub.take_new([&](const telemetry::RecordedInput& in) {
+      if (const auto* t = std::get_if<telemetry::TrackerSample>(&in.what); t && k >= 10) samples.push_back(tracked_pose(*t));
     });
   }
   hub.stop();
@@ -176,10 +176,10 @@ TEST_F(CalibrationEndToEnd, TheCalibratedRigMapsTheInstrumentWhereItIs) {
   // Averaged over 100 samples (0.1 s), so the check is of the mapping, not of one sample's noise.
   InstrumentPose with, without;
   core::Vec3 with_sum = core::Vec3::Zero(), without_sum = core::Vec3::Zero();
-  const std::vector<DecodedTracker> samples = tracked_through_the_rig(truth);
-  for (const DecodedTracker& t : samples) {
-    ASSERT_TRUE(map_through_port(t.pose, *calibrated.measured_ports[0], core::Quat::Identity(), calibrated.calibration[0], with));
-    ASSERT_TRUE(map_through_port(t.pose, Port{true_port(0), true_port(0).normalized()}, core::Quat::Identity(),
+  const std::vector<TrackedPose> samples = tracked_through_the_rig(truth);
+  for (const TrackedPose& pose : samples) {
+    ASSERT_TRUE(map_through_port(pose, *calibrated.measured_ports[0], core::Quat::Identity(), calibrated.calibration[0], with));
+    ASSERT_TRUE(map_through_port(pose, Port{true_port(0), true_port(0).normalized()}, core::Quat::Identity(),
                                  plain.calibration[0], without));
     with_sum += with.tip_mm, without_sum += without.tip_mm;
   }

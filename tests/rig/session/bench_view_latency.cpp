@@ -1,5 +1,5 @@
 // Device sample → frame containing it, per case (issue 19 item 7; target: one display period + 2 ms
-// on the rig). Each iteration moves the tool tracker to a new pose — a DeviceInput exactly as the
+// on the rig). Each iteration moves the tool tracker to a new pose — a RecordedInput exactly as the
 // tracker driver delivers it — and times, on this machine, the work between its arrival and the
 // stereo frame (1280×1024 per eye, read back) that shows it:
 //   apply (port pivot, calibration) → one physics step → capture_view (physics' copy for the
@@ -81,7 +81,7 @@ void BM_SampleToFrame(benchmark::State& state, const std::string& name) {
   for (auto _ : state) {
     // A new pose each time (the tip 0.3 mm to one side or the other).
     const core::Vec3 tip = base + (k++ % 2 ? 0.3 : -0.3) * (pc.focus_mm - port).normalized().unitOrthogonal();
-    const telemetry::DeviceInput sample = rig::testing::tracker_sample(rig::kToolTracker, tip, 0.3);
+    const telemetry::RecordedInput sample = rig::testing::tracker_sample(rig::kToolTracker, tip, 0.3);
     const auto t0 = Clock::now();
     model.apply(sample);
     model.step();

@@ -290,14 +290,7 @@ TEST_F(CaseFrames, WireframeAndZoomChangeThePicture) {
     EXPECT_TRUE(rig::capture_view(model, 1, 0.001, v));
     return builder.build(v);
   };
-  auto command = [&](int code, double value) {
-    telemetry::DeviceInput in;
-    in.device_kind = rig::kCommandKind;
-    in.n_values = 2;
-    in.values[0] = code;
-    in.values[1] = value;
-    ASSERT_TRUE(model.apply(in));
-  };
+  auto command = [&](int code, double value) { ASSERT_TRUE(model.apply(rig::testing::command_input(code, value))); };
   const vr::FrameScene base = frame_of();
   command(7, 0);  // toggle wireframe
   const vr::FrameScene wire = frame_of();
@@ -336,11 +329,7 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
   ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kLightPipeTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
   ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kToolTracker, tp + 8.0 * (aim - tp).normalized(), 0.0)));
-  telemetry::DeviceInput zoom;
-  zoom.device_kind = rig::kCommandKind;
-  zoom.n_values = 2;
-  zoom.values[0] = 9;
-  zoom.values[1] = 4.0;
+  const telemetry::RecordedInput zoom = rig::testing::command_input(9, 4.0);
   // The microscope over the aim (a pan command from the case's region of interest; the X–Y motor is
   // quickest at low magnification), then zoomed in.
   const core::Vec2 offset = model.scene().eye.fundus_coords(aim) - model.microscope().region_of_interest_mm();
@@ -349,12 +338,12 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   ASSERT_TRUE(model.apply(zoom));
   for (int i = 0; i < 4000 && model.microscope().zoom() != 4.0; ++i) model.step();
   auto pedal = [](int switches) {
-    telemetry::DeviceInput in;
-    in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
-    in.n_values = 7;
-    in.values[0] = 0;  // the vitrectomy pedal
-    in.values[1] = 2;
-    in.values[6] = switches;
+    telemetry::PedalSample s;
+    s.pedal_id = 0;  // the vitrectomy pedal
+    s.axis_count = 2;
+    s.switches = static_cast<std::uint16_t>(switches);
+    telemetry::RecordedInput in;
+    in.what = s;
     return in;
   };
   rig::FrameBuilder builder;
@@ -412,13 +401,13 @@ TEST_F(CaseFrames, FluidAirExchangeLowersTheLevelTheFrameShows) {
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
   ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kToolTracker, tp + 12.0 * (c.focus_mm - tp).normalized(), 0.0)));
   auto pedal = [](double vacuum, int switches) {
-    telemetry::DeviceInput in;
-    in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
-    in.n_values = 7;
-    in.values[0] = 0;
-    in.values[1] = 2;
-    in.values[2] = vacuum;
-    in.values[6] = switches;
+    telemetry::PedalSample s;
+    s.pedal_id = 0;
+    s.axis_count = 2;
+    s.axes[0] = vacuum;
+    s.switches = static_cast<std::uint16_t>(switches);
+    telemetry::RecordedInput in;
+    in.what = s;
     return in;
   };
   rig::FrameBuilder builder;

@@ -86,13 +86,7 @@ int main(int argc, char** argv) {
     rig::testing::CaseUnderTest under_test(scenes + "/" + name + ".toml", retina,
                                            (std::filesystem::temp_directory_path() / "vitreo-case-view-cache").string());
     rig::SimulationModel& model = under_test.model;
-    auto command = [&](int code, double a, double b) {
-      telemetry::DeviceInput in;
-      in.device_kind = rig::kCommandKind;
-      in.n_values = 3;
-      in.values[0] = code, in.values[1] = a, in.values[2] = b;
-      return model.apply(in);
-    };
+    auto command = [&](int code, double a, double b) { return model.apply(rig::testing::command_input(code, a, b)); };
     if (zoom > 0.0) command(9, zoom, 0);
     if (pan.size() == 2) command(10, pan[0], pan[1]);
     if (focus != 0.0) command(11, focus, 0);

@@ -33,37 +33,36 @@ std::vector<std::string> shipped_case_names() {
   return out;
 }
 
-telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation, const core::Quat& orientation) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(InputKind::Tracker);
-  in.n_values = 11;
-  in.values[0] = tip.x(), in.values[1] = tip.y(), in.values[2] = tip.z();
+telemetry::RecordedInput tracker_sample(int id, const core::Vec3& tip, double actuation, const core::Quat& orientation) {
+  telemetry::TrackerSample s;
+  s.tip_mm = {tip.x(), tip.y(), tip.z()};
   // Orientation: the shaft is rebuilt from the port through the tip; the x axis gives the roll.
-  in.values[3] = orientation.w(), in.values[4] = orientation.x(), in.values[5] = orientation.y(), in.values[6] = orientation.z();
-  in.values[7] = actuation;
-  in.values[8] = 1.0;
-  in.values[9] = id;
+  s.q_wxyz = {orientation.w(), orientation.x(), orientation.y(), orientation.z()};
+  s.actuation = actuation;
+  s.quality = 1.0;
+  s.instrument_id = static_cast<std::uint8_t>(id);
   // Tool type (PROTOCOL.md): the light pipe's hand holds a light pipe (1); the tool hand a universal
   // handpiece (0), so the case's first tool is in it, as golden/README.md says.
-  in.values[10] = id == kLightPipeTracker ? 1 : 0;
+  s.tool_type = id == kLightPipeTracker ? 1 : 0;
+  telemetry::RecordedInput in;
+  in.what = s;
   return in;
 }
 
-telemetry::DeviceInput command_input(int code, double a, double b) {
-  telemetry::DeviceInput in;
-  in.device_kind = kCommandKind;
-  in.n_values = 3;
-  in.values[0] = code, in.values[1] = a, in.values[2] = b;
+telemetry::RecordedInput command_input(int code, double a, double b) {
+  telemetry::RecordedInput in;
+  in.what = telemetry::OperatorCommand{static_cast<std::int8_t>(code), a, b};
   return in;
 }
 
-telemetry::DeviceInput pedal_input(int pedal, double a0, double a1, double a2, double a3, int switches) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(InputKind::Pedals);
-  in.n_values = 7;
-  in.values[0] = pedal, in.values[1] = 4;
-  in.values[2] = a0, in.values[3] = a1, in.values[4] = a2, in.values[5] = a3;
-  in.values[6] = switches;
+telemetry::RecordedInput pedal_input(int pedal, double a0, double a1, double a2, double a3, int switches) {
+  telemetry::PedalSample s;
+  s.pedal_id = static_cast<std::uint8_t>(pedal);
+  s.axis_count = 4;
+  s.axes = {a0, a1, a2, a3};
+  s.switches = static_cast<std::uint16_t>(switches);
+  telemetry::RecordedInput in;
+  in.what = s;
   return in;
 }
 

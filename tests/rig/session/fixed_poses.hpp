@@ -28,13 +28,13 @@ struct CaseUnderTest {
 // A tracker sample for instrument `id` with its tip at `tip` (eye-fixture frame); the orientation
 // is left to the port (the shaft is rebuilt from the port through the tip).
 // `orientation`: the tracker's rotation (its x axis sets the instrument's roll about the shaft).
-telemetry::DeviceInput tracker_sample(int id, const core::Vec3& tip, double actuation,
+telemetry::RecordedInput tracker_sample(int id, const core::Vec3& tip, double actuation,
                                       const core::Quat& orientation = core::Quat::Identity());
 
 // An operator command as the session records it (code: telemetry::CommandCode; b: pan's y).
-telemetry::DeviceInput command_input(int code, double a = 0.0, double b = 0.0);
+telemetry::RecordedInput command_input(int code, double a = 0.0, double b = 0.0);
 // A pedal reading: the microscope pedal (id 1) or the vitrectomy pedal (id 0), four axes, switches.
-telemetry::DeviceInput pedal_input(int pedal, double a0, double a1, double a2, double a3, int switches = 0);
+telemetry::RecordedInput pedal_input(int pedal, double a0, double a1, double a2, double a3, int switches = 0);
 
 inline constexpr double kToolClearance_mm = 3.0;
 inline constexpr double kToolActuation = 0.3;

@@ -17,7 +17,7 @@ namespace {
 
 rig::ModelConfig laser_case() { return test::light_case("exercise_laser_tear.toml"); }
 
-telemetry::DeviceInput pedal(bool laser) { return test::pedal_switches(laser ? 1u << rig::PedalMapping{}.laser_switch : 0u); }
+telemetry::RecordedInput pedal(bool laser) { return test::pedal_switches(laser ? 1u << rig::PedalMapping{}.laser_switch : 0u); }
 
 // The endolaser 4 mm into its port, aimed at the case's region of interest.
 void hold_the_laser(rig::SimulationModel& model) {

@@ -1,5 +1,5 @@
 // Recorded inputs as the rig's devices and operator would give them, for tests that drive a
-// rig::SimulationModel directly (device_inputs.hpp's layouts), and a shipped case made light.
+// rig::SimulationModel directly (typed records, rig/telemetry/input_record.hpp), and a shipped case made light.
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -24,38 +24,35 @@ inline rig::ModelConfig light_case(const std::string& file) {
 }
 
 // A tracker's pose sample: the tip (fixture frame, mm), identity orientation, full quality.
-inline telemetry::DeviceInput tracker_sample(const core::Vec3& tip, double tool_type, int instrument_id = rig::kToolTracker) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
-  in.values[0] = tip.x();
-  in.values[1] = tip.y();
-  in.values[2] = tip.z();
-  in.values[3] = 1.0;  // q w
-  in.values[8] = 1.0;  // quality
-  in.values[9] = instrument_id;
-  in.values[10] = tool_type;
+inline telemetry::RecordedInput tracker_sample(const core::Vec3& tip, int tool_type, int instrument_id = rig::kToolTracker) {
+  telemetry::TrackerSample s;
+  s.tip_mm = {tip.x(), tip.y(), tip.z()};
+  s.quality = 1.0;
+  s.instrument_id = static_cast<std::uint8_t>(instrument_id);
+  s.tool_type = static_cast<std::uint8_t>(tool_type);
+  telemetry::RecordedInput in;
+  in.what = s;
   return in;
 }
 
 // The vitrectomy pedal at rest with these switches held.
-inline telemetry::DeviceInput pedal_switches(unsigned switches) {
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Pedals);
-  in.n_values = 7;
-  in.values[0] = 0;  // pedal id: vitrectomy
-  in.values[1] = 2;  // axis count
-  in.values[6] = switches;
+inline telemetry::RecordedInput pedal_switches(unsigned switches) {
+  telemetry::PedalSample s;
+  s.pedal_id = 0;  // the vitrectomy pedal
+  s.axis_count = 2;
+  s.switches = static_cast<std::uint16_t>(switches);
+  telemetry::RecordedInput in;
+  in.what = s;
   return in;
 }
 
 // An accepted operator command (telemetry::CommandCode) as physics records it.
-inline telemetry::DeviceInput operator_command(int code, double value) {
-  telemetry::DeviceInput in;
-  in.device_kind = rig::kCommandKind;
-  in.n_values = 2;
-  in.values[0] = code;
-  in.values[1] = value;
+inline telemetry::RecordedInput operator_command(int code, double value) {
+  telemetry::OperatorCommand c;
+  c.code = static_cast<std::int8_t>(code);
+  c.value = value;
+  telemetry::RecordedInput in;
+  in.what = c;
   return in;
 }
 

@@ -9,7 +9,7 @@ using namespace vitreo;
 
 namespace {
 
-telemetry::DeviceInput pedal(unsigned switches) { return test::pedal_switches(switches); }
+telemetry::RecordedInput pedal(unsigned switches) { return test::pedal_switches(switches); }
 
 TEST(PickSwitch, ThePickSwitchPutsTheLightPipesPickOutAndTheLaserSwitchDoesNot) {
   rig::ModelConfig mc = test::light_case("exercise_laser_tear.toml");

@@ -94,6 +94,115 @@ TEST(RigSession, ARecordedSessionReplaysToTheSameState) {
   std::filesystem::remove(config.record_path);
 }
 
+// Issue 16: the recording's inputs, read back not through vitreo's reader but with LCM's own log
+// reader and lcm-gen's device_input_t, carry the kind codes and the value layout RECORDING.md
+// documents — a session with a tracker, pedals and the eye fixture, operator commands (zoom, pan,
+// reset) and the case switch the reset causes — and the session still replays to its state.
+TEST(RigSession, RecordedInputsCarryTheDocumentedKindsAndFields) {
+  auto config = small_session("kinds", 1500);
+  const char* kEyeball = "device eyeball\nrate_hz 250\nserial 3001\nkey 0 0 0 0 0 0\nkey 1000 6 -3 4 0 2\n";
+  config.devices.push_back(
+      {"eyeball", rig::DeviceRole::eyeball, "sim:eyeball?transport=pty&link=" + temp_path("kinds-eyeball"), 3, 0, 0, 0, kEyeball});
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string commands = "z 2.5\npan 1 -0.5\nr\n";
+  ASSERT_EQ(::write(fds[1], commands.data(), commands.size()), static_cast<ssize_t>(commands.size()));
+  ::close(fds[1]);
+  config.command_fd = fds[0];
+  std::FILE* echo = std::tmpfile();
+  ASSERT_NE(echo, nullptr);
+  config.command_echo = echo;
+  const rig::SessionSummary live = rig::run_session(config);
+  ::close(fds[0]);
+  std::fclose(echo);
+
+  lcm::LogFile log(config.record_path, "r");
+  ASSERT_TRUE(log.good());
+  std::map<int, int> per_kind;
+  std::vector<double> command_codes;
+  std::int64_t last_step = -1, end_step = -1;
+  bool end_seen_last = false;
+  auto unit = [](const std::vector<double>& v, std::size_t at) {
+    return std::abs(std::hypot(std::hypot(v[at], v[at + 1]), std::hypot(v[at + 2], v[at + 3])) - 1.0) < 1e-3;
+  };
+  auto in01 = [](double x) { return x >= 0.0 && x <= 1.0; };
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev != nullptr; ev = log.readNextEvent()) {
+    if (ev->channel != telemetry::kChanRecInput) continue;
+    vitreo_lcm::device_input_t m;
+    ASSERT_EQ(m.decode(ev->data, 0, ev->datalen), ev->datalen);
+    ++per_kind[m.device_kind];
+    end_seen_last = m.device_kind == 5;
+    last_step = m.step;
+    EXPECT_EQ(m.n_raw, 0) << "format 3 keeps no raw bytes";
+    const std::vector<double>& v = m.values;
+    switch (m.device_kind) {
+      case 1:  // tracker: tip x y z, q w x y z, actuation, quality, instrument id, tool type
+        ASSERT_EQ(m.n_values, 11);
+        EXPECT_EQ(m.device_id, 1);
+        EXPECT_TRUE(unit(v, 3)) << "the pose's quaternion";
+        EXPECT_TRUE(in01(v[7]) && in01(v[8]));
+        EXPECT_EQ(v[9], 0.0) << "the script's instrument 0";
+        EXPECT_EQ(v[10], 3.0) << "the script's tool 3";
+        break;
+      case 2:  // eye fixture: q w x y z, port count, inserted ×4, depth ×4
+        ASSERT_EQ(m.n_values, 13);
+        EXPECT_EQ(m.device_id, 3);
+        EXPECT_TRUE(unit(v, 0)) << "the globe's quaternion";
+        EXPECT_TRUE(v[4] >= 0.0 && v[4] <= 4.0);
+        for (std::size_t i = 5; i < 9; ++i) EXPECT_TRUE(v[i] == 0.0 || v[i] == 1.0);
+        break;
+      case 3:  // pedal: pedal id, axis count, axes ×4, switches
+        ASSERT_EQ(m.n_values, 7);
+        EXPECT_EQ(m.device_id, 2);
+        EXPECT_TRUE(v[0] == 0.0 || v[0] == 1.0);
+        EXPECT_TRUE(v[1] >= 0.0 && v[1] <= 4.0);
+        for (std::size_t i = 2; i < 6; ++i) EXPECT_TRUE(in01(v[i])) << v[i];
+        EXPECT_TRUE(v[6] >= 0.0 && v[6] <= 65535.0 && v[6] == std::floor(v[6]));
+        break;
+      case 4:  // link change: event (1 up, 2 lost, 3 stuck), device type (the device's own, or 0 before it said)
+        ASSERT_EQ(m.n_values, 2);
+        EXPECT_TRUE(v[0] >= 1.0 && v[0] <= 3.0);
+        EXPECT_TRUE(v[1] == 0.0 || v[1] == static_cast<double>(m.device_id)) << "ids 1 tracker, 2 pedals, 3 eyeball match the device types";
+        break;
+      case 5:  // session end: steps run = its step + 1
+        ASSERT_EQ(m.n_values, 1);
+        end_step = m.step;
+        EXPECT_EQ(v[0], static_cast<double>(m.step + 1));
+        break;
+      case 6:  // operator command: code, value, pan y
+        ASSERT_EQ(m.n_values, 3);
+        command_codes.push_back(v[0]);
+        if (v[0] == 9.0) {
+          EXPECT_EQ(v[1], 2.5);
+        }
+        if (v[0] == 10.0) {
+          EXPECT_TRUE(v[1] == 1.0 && v[2] == -0.5);
+        }
+        break;
+      case 7:  // case switch: index in the header's case list
+        ASSERT_EQ(m.n_values, 1);
+        EXPECT_EQ(v[0], 0.0);
+        break;
+      default: ADD_FAILURE() << "undocumented kind " << int{m.device_kind};
+    }
+  }
+  EXPECT_GT(per_kind[1], 500) << "the tracker streamed";
+  EXPECT_GT(per_kind[2], 100) << "the eye fixture streamed";
+  EXPECT_GT(per_kind[3], 100) << "the pedals streamed";
+  EXPECT_GE(per_kind[4], 3) << "each link came up";
+  EXPECT_EQ(per_kind[5], 1);
+  EXPECT_TRUE(end_seen_last) << "the session end is the last input";
+  EXPECT_EQ(end_step, 1499);
+  EXPECT_EQ(last_step, 1499);
+  EXPECT_EQ(command_codes, (std::vector<double>{9.0, 10.0, 5.0})) << "zoom, pan, reset in order";
+  EXPECT_EQ(per_kind[7], 1) << "the reset's case reload";
+
+  const rig::ReplaySummary replay = rig::replay_session(config.record_path, config.model);
+  EXPECT_EQ(replay.verdict, telemetry::RecordingVerdict::Complete) << replay.verdict_text;
+  EXPECT_EQ(replay.state_hash, live.state_hash) << "replay diverged from the live session";
+  std::filesystem::remove(config.record_path);
+}
+
 TEST(RigSession, ScoresGoOutOnTelemetryAndTheReplayScoresTheSame) {
   auto config = small_session("scores", 1500);
   config.score_every_steps = 500;
@@ -226,16 +335,20 @@ TEST(RigSession, AStuckTrackerIsReportedWithin100MsAndItsInstrumentFrozenUntilIt
   const telemetry::Recording rec = telemetry::read_recording(config.record_path);
   ASSERT_EQ(rec.verdict, telemetry::RecordingVerdict::Complete) << rec.describe();
   std::int64_t first_same_us = -1, stuck_us = -1, up_us = -1;
-  const telemetry::DeviceInput* prev = nullptr;
+  const telemetry::TrackerSample* prev = nullptr;
+  std::int64_t prev_us = -1;
   for (const auto& in : rec.inputs) {
-    if (in.device_kind == static_cast<std::int8_t>(rig::InputKind::Tracker)) {
-      const bool same = prev && std::memcmp(prev->values, in.values, sizeof(double) * 7) == 0;
-      if (same && first_same_us < 0 && stuck_us < 0) first_same_us = prev->host_time_us;
+    if (const auto* t = std::get_if<telemetry::TrackerSample>(&in.what)) {
+      // The pose's bits: tip and orientation.
+      const bool same = prev && std::memcmp(prev->tip_mm.data(), t->tip_mm.data(), sizeof t->tip_mm) == 0 &&
+                        std::memcmp(prev->q_wxyz.data(), t->q_wxyz.data(), sizeof t->q_wxyz) == 0;
+      if (same && first_same_us < 0 && stuck_us < 0) first_same_us = prev_us;
       if (!same && stuck_us < 0) first_same_us = -1;  // a run that ended was noise, not the fault
-      prev = &in;
-    } else if (in.device_kind == rig::kLinkKind && in.channel == 0) {
-      if (in.values[0] == static_cast<double>(rig::LinkInput::Stuck) && stuck_us < 0) stuck_us = in.host_time_us;
-      if (in.values[0] == static_cast<double>(rig::LinkInput::Up) && stuck_us >= 0) up_us = in.host_time_us;
+      prev = t;
+      prev_us = in.host_time_us;
+    } else if (const auto* link = std::get_if<telemetry::LinkChange>(&in.what); link && in.channel == 0) {
+      if (link->event == telemetry::LinkEvent::Stuck && stuck_us < 0) stuck_us = in.host_time_us;
+      if (link->event == telemetry::LinkEvent::Up && stuck_us >= 0) up_us = in.host_time_us;
     }
   }
   ASSERT_GE(first_same_us, 0) << "the fault's identical poses are in the recording";
@@ -347,7 +460,7 @@ void rewrite_end_marker(const std::string& from, const std::string& to, double s
     lcm::LogEvent copy = *ev;
     vitreo_lcm::device_input_t m;
     if (ev->channel == telemetry::kChanRecInput && m.decode(ev->data, 0, ev->datalen) == ev->datalen &&
-        m.device_kind == rig::kSessionEndKind) {
+        m.device_kind == static_cast<std::int8_t>(telemetry::InputKind::SessionEnd)) {
       m.values[0] = steps;
       buf.resize(static_cast<std::size_t>(m.getEncodedSize()));
       ASSERT_GT(m.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
@@ -455,15 +568,14 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   EXPECT_NEAR(static_cast<double>(scene.world.surface(scene.retina).vertex_count()), 1500.0, 300.0);
   EXPECT_TRUE(scene.settle.settled);
   // A tracked forceps tip inside the eye puts the forceps (not another tool) in through working_1.
-  telemetry::DeviceInput in;
-  in.device_kind = static_cast<std::int8_t>(rig::InputKind::Tracker);
-  in.n_values = 11;
   const core::Vec3 tip = c.tracker_ports[0].position_mm + 4.0 * (c.focus_mm - c.tracker_ports[0].position_mm).normalized();
-  in.values[0] = tip.x(); in.values[1] = tip.y(); in.values[2] = tip.z();
-  in.values[3] = 1.0;   // q w
-  in.values[8] = 1.0;   // quality
-  in.values[9] = 0.0;   // instrument id: the tool tracker
-  in.values[10] = 3.0;  // tool type
+  telemetry::TrackerSample sample;
+  sample.tip_mm = {tip.x(), tip.y(), tip.z()};
+  sample.quality = 1.0;
+  sample.instrument_id = 0;  // the tool tracker
+  sample.tool_type = 3;
+  telemetry::RecordedInput in;
+  in.what = sample;
   ASSERT_TRUE(model.apply(in));
   model.step();
   EXPECT_TRUE(model.simulation().instrument(0).input.present);
@@ -485,17 +597,15 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
   for (int i = 0; i < 20; ++i) model.step();
   EXPECT_EQ(model.world().state_hash(), moved) << "paused physics does not advance";
   ASSERT_TRUE(model.apply(command(4, 0)));  // resume
-  telemetry::DeviceInput reload;            // a reset reaches the model as the case reloaded
-  reload.device_kind = rig::kCaseKind;
-  reload.n_values = 1;
-  reload.values[0] = 0;
+  telemetry::RecordedInput reload;  // a reset reaches the model as the case reloaded
+  reload.what = telemetry::CaseSwitch{0};
   ASSERT_TRUE(model.apply(reload));
   EXPECT_EQ(model.world().state_hash(), fresh.world().state_hash()) << "reset returns the case to its start";
   EXPECT_EQ(model.case_loads(), 1u);
   ASSERT_TRUE(model.apply(command(9, 2.5)));
   for (int i = 0; i < 1000; ++i) model.step();  // the zoom motor gets there (ln 2.5 / 1.5 s)
   EXPECT_EQ(model.microscope().zoom(), 2.5);
-  telemetry::DeviceInput bad = command(9, std::nan(""));
+  telemetry::RecordedInput bad = command(9, std::nan(""));
   EXPECT_FALSE(model.apply(bad));
   model.step();
   EXPECT_EQ(model.microscope().zoom(), 2.5);
@@ -672,10 +782,8 @@ TEST(PhysicsSide, InstallingAPreparedCaseCapturingTheViewAndASnapshotDoNotAlloca
   runtime::TripleBuffer<rig::ViewSnapshot> views;
   model.step();
   std::unique_ptr<rig::PreparedCase> next = loader.load_now(1);  // the loader thread's work
-  telemetry::DeviceInput switch_input;
-  switch_input.device_kind = rig::kCaseKind;
-  switch_input.n_values = 1;
-  switch_input.values[0] = 1;
+  telemetry::RecordedInput switch_input;
+  switch_input.what = telemetry::CaseSwitch{1};
 
   // What physics does at a step boundary: capture (three slots, each sized for the case on first use).
   g_allocations = 0;

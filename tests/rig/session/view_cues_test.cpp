@@ -524,7 +524,7 @@ TEST_F(CaseCues, MicroscopeIsSimulationStateThePictureFollows) {
   const vr::Vec2 c0 = vt::project_to_pixel(start, 0, roi, kW, kH);
   EXPECT_NEAR(c0.x, kW / 2.0f, 3.0f) << "starts centred on the region of interest";
   EXPECT_NEAR(c0.y, kH / 2.0f, 3.0f);
-  auto both = [&](const telemetry::DeviceInput& in) {
+  auto both = [&](const telemetry::RecordedInput& in) {
     EXPECT_TRUE(model.apply(in));
     EXPECT_TRUE(twin.apply(in));
   };

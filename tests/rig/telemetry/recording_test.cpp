@@ -51,31 +51,59 @@ RecordingHeader make_header() {
   return h;
 }
 
-// A sample with awkward bits: negative zero, a NaN payload, subnormals — replay must keep them.
-DeviceInput make_input(std::int64_t i) {
-  DeviceInput in;
+// Every kind of input in turn, with awkward bits where a field is measured — negative zero,
+// subnormals, thirds — that replay must keep.
+RecordedInput make_input(std::int64_t i) {
+  RecordedInput in;
   in.host_time_us = 1'000'000 + i * 1000 + (i % 3) * 7;
   in.device_time_us = 55'000'000 + i * 1000;
   in.step = i;
   in.device_id = static_cast<std::int32_t>(i % 2);
-  in.device_kind = static_cast<std::int8_t>(1 + i % 4);
   in.channel = static_cast<std::int32_t>(i % 2);
   in.sequence = 10'000 + i;
-  in.n_values = 7;
-  in.values[0] = 0.1 * static_cast<double>(i);
-  in.values[1] = -0.0;
-  in.values[2] = std::numeric_limits<double>::denorm_min() * static_cast<double>(i + 1);
-  in.values[3] = std::nan("0x5a5");
-  in.values[4] = 12.0 - 1e-9 * static_cast<double>(i);
-  in.values[5] = 1.0 / 3.0;
-  in.values[6] = static_cast<double>(i % 2);
-  in.n_raw = 5;
-  for (int k = 0; k < 5; ++k) in.raw[k] = static_cast<std::uint8_t>(i * 31 + k);
+  const double tenth = 0.1 * static_cast<double>(i);
+  const double tiny = std::numeric_limits<double>::denorm_min() * static_cast<double>(i + 1);
+  const double third = 1.0 / 3.0;
+  switch (i % 7) {
+    case 0: {
+      TrackerSample t;
+      t.tip_mm = {tenth, -0.0, tiny};
+      t.q_wxyz = {third, -third, 12.0 - 1e-9 * static_cast<double>(i), 0.5};
+      t.actuation = third;
+      t.quality = tiny;
+      t.instrument_id = static_cast<std::uint8_t>(i % 2);
+      t.tool_type = static_cast<std::uint8_t>(i % 11);
+      in.what = t;
+      break;
+    }
+    case 1: {
+      EyeFixtureSample e;
+      e.q_wxyz = {third, -0.0, tiny, tenth};
+      e.port_count = 4;
+      e.inserted = {true, false, false, true};
+      e.depth_mm = {tenth, -0.0, tiny, third};
+      in.what = e;
+      break;
+    }
+    case 2: {
+      PedalSample p;
+      p.pedal_id = static_cast<std::uint8_t>(i % 2);
+      p.axis_count = 4;
+      p.axes = {third, -0.0, tiny, 1.0};
+      p.switches = static_cast<std::uint16_t>(0x8001 + i);
+      in.what = p;
+      break;
+    }
+    case 3: in.what = LinkChange{static_cast<LinkEvent>(1 + i % 3), static_cast<std::uint8_t>(i % 4)}; break;
+    case 4: in.what = SessionEnd{i + 1}; break;
+    case 5: in.what = OperatorCommand{static_cast<std::int8_t>(1 + i % 16), tenth, -0.0}; break;
+    default: in.what = CaseSwitch{static_cast<std::int32_t>(i % 5)}; break;
+  }
   return in;
 }
 
-std::vector<DeviceInput> record(const std::string& path, int n) {
-  std::vector<DeviceInput> sent;
+std::vector<RecordedInput> record(const std::string& path, int n) {
+  std::vector<RecordedInput> sent;
   Recorder rec(path, make_header());
   for (int i = 0; i < n; ++i) {
     sent.push_back(make_input(i));
@@ -119,7 +147,7 @@ std::vector<EventSpan> event_spans(const std::vector<std::uint8_t>& b) {
 
 // The inputs of a recording that is not whole must be a prefix of what was sent, ending before the
 // step it is trusted through.
-void expect_verified_prefix(const Recording& rec, const std::vector<DeviceInput>& sent) {
+void expect_verified_prefix(const Recording& rec, const std::vector<RecordedInput>& sent) {
   ASSERT_LE(rec.inputs.size(), sent.size());
   for (std::size_t i = 0; i < rec.inputs.size(); ++i) ASSERT_TRUE(rec.inputs[i] == sent[i]) << i;
   if (!rec.inputs.empty()) {
@@ -151,7 +179,7 @@ TEST(Recording, RoundTripIsBitExactAndCarriesTheHeader) {
   EXPECT_EQ(rec.header.config_text, make_header().config_text);
   EXPECT_EQ(rec.header.snapshot_ref, "snapshots/rrd-superior-01.start.vsnap");
   EXPECT_EQ(rec.header.snapshot_hash, "9e3779b97f4a7c15");
-  EXPECT_EQ(rec.header.format_version, 2);
+  EXPECT_EQ(rec.header.format_version, 3);
   EXPECT_GT(rec.header.utime_us, 0);
   ASSERT_EQ(rec.inputs.size(), sent.size());
   for (std::size_t i = 0; i < sent.size(); ++i) ASSERT_TRUE(rec.inputs[i] == sent[i]) << "input " << i;
@@ -345,6 +373,47 @@ TEST(Recording, RejectsFilesThatAreNotRecordings) {
   std::remove(future.c_str());
 }
 
+// Issue 16: format 3 types its inputs. A recording of format 2 (here a real one with its header's
+// version put back to 2, rewritten with LCM's own log reader and writer and lcm-gen's header type)
+// is refused with one line that names the file and both versions — never read as if it were 3.
+TEST(Recording, AVersion2RecordingIsRefusedNamingBothVersions) {
+  const std::string v3 = temp_path("rec-v3");
+  const std::string v2 = temp_path("rec-v2");
+  record(v3, 20);
+  {
+    lcm::LogFile in(v3, "r");
+    lcm::LogFile out(v2, "w");
+    ASSERT_TRUE(in.good() && out.good());
+    std::vector<std::uint8_t> buf;
+    for (const lcm::LogEvent* ev = in.readNextEvent(); ev != nullptr; ev = in.readNextEvent()) {
+      lcm::LogEvent copy = *ev;
+      if (ev->channel == kChanRecHeader) {
+        vitreo_lcm::recording_header_t h;
+        ASSERT_EQ(h.decode(ev->data, 0, ev->datalen), ev->datalen);
+        ASSERT_EQ(h.format_version, 3);
+        h.format_version = 2;
+        buf.resize(static_cast<std::size_t>(h.getEncodedSize()));
+        ASSERT_EQ(h.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+        copy.data = buf.data();
+        copy.datalen = static_cast<std::int32_t>(buf.size());
+      }
+      ASSERT_EQ(out.writeEvent(&copy), 0);
+    }
+  }
+  try {
+    read_recording(v2);
+    ADD_FAILURE() << "a version-2 recording was accepted";
+  } catch (const RecordingError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("recording format version 2, this vitreo reads 3"), std::string::npos) << what;
+    EXPECT_NE(what.find(v2), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+  EXPECT_EQ(read_recording(v3).verdict, RecordingVerdict::Complete) << "the same file at version 3 reads";
+  std::remove(v3.c_str());
+  std::remove(v2.c_str());
+}
+
 // Issue 20: a header whose first string length is INT_MIN made `vitreo --replay` segfault. Now it
 // is a recording that does not start with a header, said with the file's name.
 TEST(Recording, HeaderWithStringLengthIntMinIsRefusedWithTheFilesName) {
@@ -420,7 +489,7 @@ TEST(Replay, PacesInputsByTheirRecordedTimesOnASimulatedClock) {
     SimulatedClock clock(123'000'000);
     std::vector<std::int64_t> at;
     std::size_t k = 0;
-    const std::size_t n = replay(rec, clock, ReplayOptions{speed}, [&](const DeviceInput& in) {
+    const std::size_t n = replay(rec, clock, ReplayOptions{speed}, [&](const RecordedInput& in) {
       EXPECT_TRUE(in == sent[k]) << k;
       ++k;
       at.push_back(clock.now_ns() - 123'000'000);
@@ -434,7 +503,7 @@ TEST(Replay, PacesInputsByTheirRecordedTimesOnASimulatedClock) {
   // As fast as possible on the wall clock: 100 inputs spanning ~99 ms take far less.
   SteadyClock wall;
   const std::int64_t t0 = wall.now_ns();
-  EXPECT_EQ(replay(rec, wall, ReplayOptions{0.0}, [](const DeviceInput&) {}), 100u);
+  EXPECT_EQ(replay(rec, wall, ReplayOptions{0.0}, [](const RecordedInput&) {}), 100u);
   EXPECT_LT(wall.now_ns() - t0, 50'000'000);
   std::remove(path.c_str());
 }
@@ -447,7 +516,7 @@ TEST(Replay, RealTimeOnTheWallClockTakesTheRecordedSpan) {
   SteadyClock wall;
   std::vector<std::int64_t> late_ns;
   const std::int64_t t0 = wall.now_ns();
-  replay(rec, wall, ReplayOptions{1.0}, [&](const DeviceInput& in) {
+  replay(rec, wall, ReplayOptions{1.0}, [&](const RecordedInput& in) {
     const double due = static_cast<double>(in.host_time_us - sent.front().host_time_us) * 1000.0;
     late_ns.push_back(wall.now_ns() - t0 - static_cast<std::int64_t>(due));
   });
@@ -461,14 +530,14 @@ TEST(Replay, RealTimeOnTheWallClockTakesTheRecordedSpan) {
 TEST(Replay, InputCursorFeedsEachStepItsInputs) {
   Recording rec;
   for (std::int64_t step : {0, 0, 1, 3, 3, 3, 7}) {
-    DeviceInput in;
+    RecordedInput in;
     in.step = step;
     in.sequence = static_cast<std::int64_t>(rec.inputs.size());
     rec.inputs.push_back(in);
   }
   InputCursor cur(rec);
   std::vector<std::int64_t> seq;
-  auto take = [&](const DeviceInput& in) { seq.push_back(in.sequence); };
+  auto take = [&](const RecordedInput& in) { seq.push_back(in.sequence); };
   EXPECT_EQ(cur.feed_through_step(0, take), 2u);
   EXPECT_EQ(cur.feed_through_step(1, take), 1u);
   EXPECT_EQ(cur.feed_through_step(2, take), 0u);
@@ -496,7 +565,7 @@ TEST(Recording, SigkillLosesAtMost100MsOfInput) {
     const std::int64_t t0 = clock.now_ns();
     for (std::int64_t i = 0;; ++i) {
       clock.sleep_until_ns(t0 + i * 1'000'000);
-      DeviceInput in = make_input(i);
+      RecordedInput in = make_input(i);
       rec.push(in);
       rec.pump(clock.now_ns());
       const std::int64_t pushed = i;

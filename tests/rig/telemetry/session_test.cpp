@@ -27,15 +27,16 @@
 #include "rig/telemetry/recording.hpp"
 
 using namespace vitreo;
-using telemetry::DeviceInput;
+using telemetry::RecordedInput;
 
 namespace {
 // Stand-in for the core: deterministic, sensitive to every input bit and to the step it arrives at.
 struct ToyModel {
   double x[3] = {0, 0, 12.0}, v[3] = {0, 0, 0}, target[3] = {0, 0, 12.0};
   std::uint64_t inputs = 0;
-  void apply(const DeviceInput& in) {
-    for (int i = 0; i < 3; ++i) target[i] = in.values[i];
+  void apply(const RecordedInput& in) {
+    const auto& tip = std::get<telemetry::TrackerSample>(in.what).tip_mm;
+    for (std::size_t i = 0; i < 3; ++i) target[i] = tip[i];
     ++inputs;
   }
   void step(double dt) {
@@ -70,7 +71,7 @@ TEST(Session, RecordedSessionReplaysToTheSameStateHash) {
   constexpr std::uint64_t kSteps = 400;
   const double dt = 1e-3;
 
-  runtime::TripleBuffer<DeviceInput> tracker_box;
+  runtime::TripleBuffer<RecordedInput> tracker_box;
   telemetry::TelemetryPublisher pub(telemetry::PublisherConfig{"memq://", 1024});
   telemetry::TelemetrySource& physics_tx = pub.add_source("physics");
   telemetry::CommandServer commands(pub.lcm());
@@ -90,7 +91,7 @@ TEST(Session, RecordedSessionReplaysToTheSameStateHash) {
     while (commands.poll(cmd)) {
     }
     if (tracker_box.update() && tracker_box.read_slot().sequence != last_seq) {
-      DeviceInput in = tracker_box.read_slot();
+      RecordedInput in = tracker_box.read_slot();
       last_seq = in.sequence;
       in.step = static_cast<std::int64_t>(k);
       recorder.push(in);
@@ -114,17 +115,15 @@ TEST(Session, RecordedSessionReplaysToTheSameStateHash) {
   std::atomic<bool> stop_device{false};
   std::thread device([&] {  // a simulated tracker: ~5 kHz with scheduler jitter
     for (std::int64_t seq = 0; !stop_device.load(std::memory_order_acquire); ++seq) {
-      DeviceInput& s = tracker_box.write_slot();
+      RecordedInput& s = tracker_box.write_slot();
       s.host_time_us = mono_us();
       s.device_time_us = seq * 200;
       s.device_id = 1;
-      s.device_kind = 1;
       s.sequence = seq;
-      s.n_values = 3;
       const double a = static_cast<double>(seq) * 0.01;
-      s.values[0] = 3.0 * std::sin(a);
-      s.values[1] = 2.0 * std::cos(1.3 * a);
-      s.values[2] = 12.0 - 0.5 * std::sin(0.7 * a);
+      telemetry::TrackerSample pose;
+      pose.tip_mm = {3.0 * std::sin(a), 2.0 * std::cos(1.3 * a), 12.0 - 0.5 * std::sin(0.7 * a)};
+      s.what = pose;
       tracker_box.publish();
       std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
@@ -148,7 +147,7 @@ TEST(Session, RecordedSessionReplaysToTheSameStateHash) {
   telemetry::InputCursor cursor(rec);
   runtime::SimulatedClock sim;
   runtime::FixedStepLoop loop(sim, runtime::LoopConfig{}, [&](std::uint64_t k, double) {
-    cursor.feed_through_step(static_cast<std::int64_t>(k), [&](const DeviceInput& in) { replayed.apply(in); });
+    cursor.feed_through_step(static_cast<std::int64_t>(k), [&](const RecordedInput& in) { replayed.apply(in); });
     replayed.step(dt);
   });
   const std::int64_t t0 = wall.now_ns();
