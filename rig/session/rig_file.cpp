@@ -181,11 +181,11 @@ RigFile parse_rig_file(const std::string& text, const std::string& origin, const
       const std::optional<double> x = v.is_integer() ? std::optional<double>(static_cast<double>(*v.value<std::int64_t>()))
                                       : v.is_floating_point() ? v.value<double>() : std::nullopt;
       if (k == "power_mw") {
-        if (!x || !laser_power_in_range(*x, limits))
+        if (!x || !laser_power_in_range(x.value_or(NAN), limits))
           fail(v, key, fmt::format("must be a power in [{:g}, {:g}] mW", limits.laser_power_min_mw, limits.laser_power_max_mw));
         laser.power_mw = *x;
       } else if (k == "duration_ms") {
-        if (!x || !laser_duration_in_range(*x, limits))
+        if (!x || !laser_duration_in_range(x.value_or(NAN), limits))
           fail(v, key, fmt::format("must be a pulse duration in [{:g}, {:g}] ms (one pulse per shot: no continuous mode)",
                                    limits.laser_duration_min_ms, limits.laser_duration_max_ms));
         laser.duration_ms = *x;
