@@ -29,6 +29,7 @@
 #include "rig/session/simulation_model.hpp"
 #include "fixed_poses.hpp"
 #include "image_checks.hpp"
+#include "model_inputs.hpp"
 #include "synthetic_scene.hpp"
 #include "vitreo/render/egl_context.hpp"
 #include "vitreo/render/image_compare.hpp"
@@ -337,22 +338,13 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   for (int i = 0; i < 4000 && model.microscope().center_mm() != model.scene().eye.fundus_coords(aim); ++i) model.step();
   ASSERT_TRUE(model.apply(zoom));
   for (int i = 0; i < 4000 && model.microscope().zoom() != 4.0; ++i) model.step();
-  auto pedal = [](int switches) {
-    telemetry::PedalSample s;
-    s.pedal_id = 0;  // the vitrectomy pedal
-    s.axis_count = 2;
-    s.switches = static_cast<std::uint16_t>(switches);
-    telemetry::RecordedInput in;
-    in.what = s;
-    return in;
-  };
   rig::FrameBuilder builder;
   rig::ViewSnapshot before_view;
   ASSERT_TRUE(rig::capture_view(model, 1, 0.001, before_view));
   const vr::FrameScene before = builder.build(before_view);
-  ASSERT_TRUE(model.apply(pedal(1 << 1)));  // laser switch (default mapping: switch 1)
+  ASSERT_TRUE(model.apply(test::pedal_switches(1u << 1)));  // laser switch (default mapping: switch 1)
   model.step();
-  ASSERT_TRUE(model.apply(pedal(0)));
+  ASSERT_TRUE(model.apply(test::pedal_switches(0)));
   model.step();
   ASSERT_EQ(model.simulation().burns().size(), 1u) << "one pulse on the rising edge";
   const core::Vec3 hit = model.simulation().burn_position(model.simulation().burns()[0]);

@@ -73,6 +73,27 @@ rig::SessionConfig small_session(const std::string& tag, std::uint64_t steps) {
   return c;
 }
 
+// Runs the session with `typed` piped in as operator commands on its terminal channel (the pipe closes
+// right after them); what the rig echoed back ("> …: accepted") is returned in `echoed`.
+rig::SessionSummary run_with_typed_commands(rig::SessionConfig& config, const std::string& typed, std::string& echoed) {
+  int fds[2];
+  EXPECT_EQ(::pipe(fds), 0);
+  EXPECT_EQ(::write(fds[1], typed.data(), typed.size()), static_cast<ssize_t>(typed.size()));
+  ::close(fds[1]);
+  config.command_fd = fds[0];
+  std::FILE* echo = std::tmpfile();
+  EXPECT_NE(echo, nullptr);
+  config.command_echo = echo;
+  const rig::SessionSummary summary = rig::run_session(config);
+  ::close(fds[0]);
+  std::rewind(echo);
+  echoed.clear();
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, echo)) echoed += buf;
+  std::fclose(echo);
+  return summary;
+}
+
 }  // namespace
 
 TEST(RigSession, ARecordedSessionReplaysToTheSameState) {
@@ -103,18 +124,8 @@ TEST(RigSession, RecordedInputsCarryTheDocumentedKindsAndFields) {
   const char* kEyeball = "device eyeball\nrate_hz 250\nserial 3001\nkey 0 0 0 0 0 0\nkey 1000 6 -3 4 0 2\n";
   config.devices.push_back(
       {"eyeball", rig::DeviceRole::eyeball, "sim:eyeball?transport=pty&link=" + temp_path("kinds-eyeball"), 3, 0, 0, 0, kEyeball});
-  int fds[2];
-  ASSERT_EQ(::pipe(fds), 0);
-  const std::string commands = "z 2.5\npan 1 -0.5\nr\n";
-  ASSERT_EQ(::write(fds[1], commands.data(), commands.size()), static_cast<ssize_t>(commands.size()));
-  ::close(fds[1]);
-  config.command_fd = fds[0];
-  std::FILE* echo = std::tmpfile();
-  ASSERT_NE(echo, nullptr);
-  config.command_echo = echo;
-  const rig::SessionSummary live = rig::run_session(config);
-  ::close(fds[0]);
-  std::fclose(echo);
+  std::string echoed;
+  const rig::SessionSummary live = run_with_typed_commands(config, "z 2.5\npan 1 -0.5\nr\n", echoed);
 
   lcm::LogFile log(config.record_path, "r");
   ASSERT_TRUE(log.good());
@@ -620,23 +631,9 @@ TEST(SimulationModel, OperatorCommandsAreRecordedInputs) {
 // and accepted), and a last line without its newline is still executed.
 TEST(RigSession, PipedCommandsAreDecidedInOrderAndTheLastLineCountsWithoutItsNewline) {
   auto config = small_session("piped", 1500);
-  int fds[2];
-  ASSERT_EQ(::pipe(fds), 0);
   const std::string name70(70, 'a');
-  const std::string script = "pause\nresume\ns " + name70 + "\nw";
-  ASSERT_EQ(::write(fds[1], script.data(), script.size()), static_cast<ssize_t>(script.size()));
-  ::close(fds[1]);  // end of input right after "w"
-  config.command_fd = fds[0];
-  std::FILE* echo = std::tmpfile();
-  ASSERT_NE(echo, nullptr);
-  config.command_echo = echo;
-  const rig::SessionSummary live = rig::run_session(config);
-  ::close(fds[0]);
-  std::rewind(echo);
-  std::string acks;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, echo)) acks += buf;
-  std::fclose(echo);
+  std::string acks;  // end of input right after "w"
+  const rig::SessionSummary live = run_with_typed_commands(config, "pause\nresume\ns " + name70 + "\nw", acks);
   const auto pause = acks.find("> pause: accepted"), resume = acks.find("> resume: accepted");
   EXPECT_NE(pause, std::string::npos) << acks;
   EXPECT_NE(resume, std::string::npos) << acks;
