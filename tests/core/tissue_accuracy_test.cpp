@@ -23,6 +23,7 @@
 #include "core/tissue/tissue_world.hpp"
 #include "core/topology/clean_topology.hpp"
 #include "core/topology/cut.hpp"
+#include "strip_stiffness.hpp"
 #include "test_meshes.hpp"
 
 using namespace vitreo::core;
@@ -49,116 +50,6 @@ double settle(TissueWorld& world, double max_s) {
     if (world.awake_blocks() == 0) break;
   }
   return i * kDt;
-}
-
-// ---- A strip cut from the retina's own mesh ---------------------------------------------------
-// The retina of the solver benchmark (core/anatomy/retina_cap: a revolved sphere cap, R 12 mm) at
-// the given resolution; the triangles within a band around its equator, W wide across the rings
-// and L long around the axis, laid flat (x along the azimuth, y across the rings). Near the
-// equator the rings barely change radius, so the triangles keep their shape.
-TriangleMesh retina_strip(int retina_vertices, double width_mm, double length_mm) {
-  RetinaCapOptions o;
-  o.retina_vertices = retina_vertices;
-  o.detachment = false;
-  const RetinaCapScene scene = build_retina_cap(o);
-  const Surface& s = scene.world.surface(scene.retina);
-  const double R = o.globe_radius_mm;
-  auto flat = [&](std::uint32_t v) {
-    const Vec3& p = s.rest_position(v);
-    const double polar = std::acos(std::clamp(-p.z() / p.norm(), -1.0, 1.0));  // from the posterior pole
-    const double azimuth = std::atan2(p.y(), p.x());
-    return Vec3(R * azimuth, R * (polar - kPi / 2), 0.0);
-  };
-  TriangleMesh m;
-  std::vector<std::uint32_t> index(s.vertex_slots(), kNone);
-  for (std::uint32_t t = 0; t < s.triangle_slots(); ++t) {
-    if (!s.triangle_alive(t)) continue;
-    const auto tv = s.triangle_vertices(t);
-    bool inside = true;
-    for (const auto v : tv) {
-      const Vec3 p = flat(v);
-      inside = inside && std::abs(p.y()) <= width_mm / 2 && p.x() >= 0.0 && p.x() <= length_mm;
-    }
-    if (!inside) continue;
-    std::array<std::uint32_t, 3> out{};
-    for (std::size_t k = 0; k < 3; ++k) {
-      if (index[tv[k]] == kNone) {
-        index[tv[k]] = static_cast<std::uint32_t>(m.positions.size());
-        m.positions.push_back(flat(tv[k]));
-      }
-      out[k] = index[tv[k]];
-    }
-    m.triangles.push_back(out);
-  }
-  return m;
-}
-
-struct StripResult {
-  double modulus = 0.0;  // traction / strain, µN/mm
-  double settle_s = 0.0;
-  std::size_t vertices = 0;
-};
-
-// Clamps the strip's left end, pulls its right end with a traction σ spread along the end by each
-// vertex's share of the width (a local force toward a far point), and measures the strain between
-// material lines at a third and two thirds of the length once the tissue has come to rest.
-StripResult stretch_strip(const TriangleMesh& mesh, const TissueMaterial& material, double strain_target) {
-  SurfaceDescription d;
-  d.mesh = mesh;
-  d.material = material;
-  d.material.tear_strain = INFINITY;
-  d.contained_by_globe = false;
-  TissueWorld world(far_wall(), weightless());
-  const std::uint32_t id = world.add_surface(d);
-  Surface& s = world.surface(id);
-  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9, edge = 0.0;
-  for (const auto& p : mesh.positions) {
-    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
-  }
-  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) edge = std::max(edge, s.edge_rest_length(e));
-  const double width = y1 - y0, sigma = strain_target * material.membrane_modulus_pa_mm;
-  std::vector<std::uint32_t> pulled;
-  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-    if (s.rest_position(v).x() < x0 + 0.3 * edge) {
-      EXPECT_TRUE(s.set_fixed(s.vertex_id(v), true));
-    }
-    if (s.rest_position(v).x() > x1 - 0.3 * edge) pulled.push_back(v);
-  }
-  std::sort(pulled.begin(), pulled.end(), [&](auto a, auto b) { return s.rest_position(a).y() < s.rest_position(b).y(); });
-  LocalForceDescription f;
-  f.name = "pull";
-  f.surface = id;
-  f.toward_point_mm = Vec3(1e9, 0.5 * (y0 + y1), 0.0);
-  f.pressure_pa = 1e5;
-  double total = 0.0;
-  for (std::size_t i = 0; i < pulled.size(); ++i) {
-    const double lo = i == 0 ? y0 : 0.5 * (s.rest_position(pulled[i - 1]).y() + s.rest_position(pulled[i]).y());
-    const double hi = i + 1 == pulled.size() ? y1 : 0.5 * (s.rest_position(pulled[i]).y() + s.rest_position(pulled[i + 1]).y());
-    const double force = sigma * (hi - lo);
-    total += force;
-    f.vertices.push_back(pulled[i]);
-    f.weights.push_back(force / (f.pressure_pa * s.vertex_rest_area(pulled[i])));
-  }
-  world.add_local_force(f);
-  EXPECT_NEAR(total, sigma * width, 1e-9 * sigma * width);
-
-  StripResult r;
-  r.vertices = mesh.positions.size();
-  r.settle_s = settle(world, 10.0);
-  auto mean_x = [&](double at) {
-    double now = 0.0, rest = 0.0;
-    int n = 0;
-    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-      if (std::abs(s.rest_position(v).x() - at) > 0.6 * edge) continue;
-      now += s.position(v).x(), rest += s.rest_position(v).x(), ++n;
-    }
-    return std::pair{now / n, rest / n};
-  };
-  const auto [a_now, a_rest] = mean_x(x0 + (x1 - x0) / 3);
-  const auto [b_now, b_rest] = mean_x(x0 + 2 * (x1 - x0) / 3);
-  const double strain = ((b_now - a_now) - (b_rest - a_rest)) / (b_rest - a_rest);
-  r.modulus = sigma / strain;
-  return r;
 }
 
 // ---- The elastic catenary --------------------------------------------------------------------
@@ -196,10 +87,13 @@ struct ElasticCatenary {
 
 TEST(TissueAccuracy, RetinaStripStretchesAtItsNominalModulus) {
   // Resolutions: the main job's retina (5k), the cases' (8k, 12k, 20k; 20k is also the solver
-  // benchmark's) and a finer one (40k). A 1 % pull, read once the tissue has come to rest.
+  // benchmark's) and a finer one (40k). A 1 % pull, read once the tissue has come to rest
+  // (strip_stiffness.hpp: the same measurement the solver benchmark reports as a counter).
   const TissueMaterial retina;  // the retina's values (scenes/materials.toml)
   for (const int n : {5000, 8000, 12000, 20000, 40000}) {
-    const StripResult r = stretch_strip(retina_strip(n, 2.0, 8.0), retina, 0.01);
+    const vitreo::test::StripResult r = vitreo::test::stretch_strip(vitreo::test::retina_strip(n, 2.0, 8.0), retina, 0.01);
+    ASSERT_TRUE(r.clamped && r.steps_ok) << n;
+    EXPECT_NEAR(r.applied_force_un, r.expected_force_un, 1e-9 * r.expected_force_un) << n;
     const double error = r.modulus / retina.membrane_modulus_pa_mm - 1.0;
     EXPECT_LT(std::abs(error), 0.05) << n << "-vertex retina strip (" << r.vertices << " vertices): modulus " << r.modulus
                                      << " µN/mm against " << retina.membrane_modulus_pa_mm << ", settled in " << r.settle_s << " s";
