@@ -55,7 +55,9 @@ void TopologyAdapter::cut(TissueWorld& /*world*/, const CuttingPose& pose) {
   }
 }
 
-void TopologyAdapter::remove(TissueWorld& /*world*/, const RemovalRequest& request) {
+void TopologyAdapter::remove(TissueWorld& world, const RemovalRequest& request) {
+  bool cut = false;
+  double reach_mm = 0.0;
   for (auto& v : vitrectors_) {
     Status s = v->set_pose(request.port_center_mm, request.port_normal);
     if (s) s = v->set_cut_rate(std::min(request.cut_rate_cpm, v->settings().max_cut_rate_cpm));
@@ -67,7 +69,12 @@ void TopologyAdapter::remove(TissueWorld& /*world*/, const RemovalRequest& reque
     const VitrectorStepResult r = v->apply(request.dt_s);
     if (!r.status) last_error_ = r.status;
     removed_mass_g_ += r.removed_mass_g;
+    cut = cut || r.cut;
+    reach_mm = std::max(reach_mm, v->settings().removal_radius_mm);
   }
+  // The guillotine also cuts the stalks (pegs) that bridge two layers within its reach: a
+  // vitrector slid between an elevated membrane and the retina delaminates it.
+  if (cut) stalks_cut_ += world.cut_attachments_in(request.port_center_mm, request.port_normal, reach_mm);
 }
 
 }  // namespace vitreo::core

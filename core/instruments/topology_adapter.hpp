@@ -39,6 +39,7 @@ class TopologyAdapter final : public TopologyActions {
   // changed under a crack in a way it could not follow.
   std::uint32_t gaps() const { return gaps_; }
   double removed_mass_g() const { return removed_mass_g_; }
+  std::uint64_t stalks_cut() const { return stalks_cut_; }  // attachments the guillotine severed
   const Status& last_error() const { return last_error_; }
 
  private:
@@ -53,6 +54,7 @@ class TopologyAdapter final : public TopologyActions {
   std::vector<std::unique_ptr<Vitrector>> vitrectors_;
   std::uint32_t springs_opened_ = 0, gaps_ = 0;
   double removed_mass_g_ = 0.0;
+  std::uint64_t stalks_cut_ = 0;
   Status last_error_ = Status::ok();
 };
 

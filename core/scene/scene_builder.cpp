@@ -341,7 +341,8 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
           fixed.push_back(at_base ? 1 : 0);
           // Anteroposterior traction: the band's anterior end is held by the vitreous base, standing
           // inward of the retina (anterior PVR), so contraction pulls the retina forward and inward.
-          d.mesh.positions.push_back(at_base ? Vec3(p - p.normalized() * spec.height_mm) : p);
+          // Elsewhere the band stands spec.elevation_mm off the retina on its stalks (0: on it).
+          d.mesh.positions.push_back(p - p.normalized() * (at_base ? spec.height_mm : spec.elevation_mm));
           if (at_base) from_retina.back() = kNone;
         }
         mt[k] = to_m[t[k]];
@@ -374,6 +375,7 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
     a.vertex_b = from_retina[v];
     a.stiffness_un_per_mm = 2e3;
     a.break_force_un = strong ? spec.strong_break_force_un : spec.weak_break_force_un;
+    a.rest_length_mm = spec.elevation_mm;
     world.add_attachment(a);
     ++out.attachment_count;
     if (strong) ++out.strong_attachments;

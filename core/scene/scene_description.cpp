@@ -160,6 +160,10 @@ void SceneDescription::validate() const {
     if (std::isnan(m.weak_break_force_un) || !(m.weak_break_force_un > 0.0)) throw InvalidArgument(w + "weak_break_force_un must be > 0");
     if (std::isnan(m.strong_break_force_un) || !(m.strong_break_force_un > 0.0)) throw InvalidArgument(w + "strong_break_force_un must be > 0");
     require_range(m.detach_radius_mm, 0.0, 15.0, w + "detach_radius_mm");
+    require_range(m.elevation_mm, 0.0, 1.5, w + "elevation_mm");
+    if (m.elevation_mm > 0.0 && m.kind != MembraneKind::kCircumferential && m.kind != MembraneKind::kAnteroposterior) {
+      throw InvalidArgument(w + "elevation_mm is for bands (circumferential, anteroposterior)");
+    }
     if (m.strong_break_force_un < m.weak_break_force_un) throw InvalidArgument(w + "strong_break_force_un must be >= weak_break_force_un");
   }
   for (const auto& i : instruments) {

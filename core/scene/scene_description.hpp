@@ -67,6 +67,12 @@ struct MembraneSpec {
   // toward the centre), so the traction can lift it and, cut, lets it settle. 0 = the retina stays
   // pressed on.
   double detach_radius_mm = 0.0;
+  // Bands only (circumferential, anteroposterior): the band stands this far off the retina on
+  // stalks — its attachments are pegs of this length (AttachmentDescription::rest_length_mm), the
+  // "table-top" elevation of fibrovascular tissue between its epicentres, which leaves the room a
+  // vitrector or horizontal scissors enter to cut the pegs (delamination). 0: the band lies on the
+  // retina, its attachments coincident instance vertices.
+  double elevation_mm = 0.0;
 };
 
 enum class GuideKind : std::uint8_t { kCutPath, kLaserRing, kTarget };

@@ -171,6 +171,7 @@ void TissueWorld::add_point_terms(double fraction) {
     t.kind = PointKind::kAttachment;
     t.owner = i;
     t.k = at.d.stiffness_un_per_mm;
+    t.offset = at.d.rest_length_mm;
     t.surface[0] = at.d.surface_a;
     t.vertex[0] = at.a.index;
     t.b[0] = 1.0;

@@ -169,8 +169,9 @@ void TissueWorld::break_attachments() {
     if (!at.intact) continue;
     const bool stale = !surfaces_[at.d.surface_a]->is_current(at.a) ||
                        (at.d.surface_b != AttachmentDescription::kWorld && !surfaces_[at.d.surface_b]->is_current(at.b));
-    if (stale || at.peak_force_un > at.d.break_force_un) {
+    if (stale || at.cut || at.peak_force_un > at.d.break_force_un) {
       at.intact = false;
+      at.cut = false;
       const Vec3 p = stale ? at.d.world_point_mm : surfaces_[at.d.surface_a]->position(at.a.index);
       if (events_.size() < events_.capacity()) {
         events_.push_back({TissueEventKind::kAttachmentBroken, at.d.surface_a, i, p, at.peak_force_un});

@@ -114,7 +114,7 @@ std::uint32_t TissueWorld::add_attachment(const AttachmentDescription& d) {
   if (d.surface_a >= surfaces_.size()) throw InvalidArgument("attachment: surface_a out of range");
   const Surface& sa = *surfaces_[d.surface_a];
   if (!sa.vertex_alive(d.vertex_a)) throw InvalidArgument("attachment: vertex_a is not a live vertex");
-  Attachment a{d, sa.vertex_id(d.vertex_a), {}, true, 0.0, 0.0};
+  Attachment a{d, sa.vertex_id(d.vertex_a), {}, true, false, 0.0, 0.0};
   if (d.surface_b == AttachmentDescription::kWorld) {
     require_finite(d.world_point_mm, "attachment: world point");
   } else {
@@ -127,6 +127,10 @@ std::uint32_t TissueWorld::add_attachment(const AttachmentDescription& d) {
   require_range(d.stiffness_un_per_mm, 1e-6, 1e12, "attachment: stiffness");
   if (std::isnan(d.break_force_un) || !(d.break_force_un > 0.0)) {
     throw InvalidArgument("attachment: break force must be > 0 (infinity = unbreakable)");
+  }
+  require_range(d.rest_length_mm, 0.0, 5.0, "attachment: rest length");
+  if (d.rest_length_mm > 0.0 && d.surface_b == AttachmentDescription::kWorld) {
+    throw InvalidArgument("attachment: a rest length needs two surfaces (a stalk between layers)");
   }
   attachments_.push_back(a);
   reserve_point_terms();
@@ -202,6 +206,26 @@ Status TissueWorld::set_local_force_scale(std::uint32_t force, double scale) {
   }
   f.scale = scale;
   return Status::ok();
+}
+
+std::uint32_t TissueWorld::cut_attachments_in(const Vec3& center_mm, const Vec3& normal, double radius_mm) {
+  const double n2 = normal.squaredNorm();
+  if (!(n2 > 0.0) || !std::isfinite(n2) || !center_mm.allFinite() || !(radius_mm > 0.0)) return 0;
+  const Vec3 n = normal / std::sqrt(n2);
+  std::uint32_t severed = 0;
+  for (Attachment& at : attachments_) {
+    if (!at.intact || at.cut || !(at.d.rest_length_mm > 0.0)) continue;
+    Surface& sa = *surfaces_[at.d.surface_a];
+    Surface& sb = *surfaces_[at.d.surface_b];
+    if (!sa.is_current(at.a) || !sb.is_current(at.b)) continue;
+    const Vec3 mid = 0.5 * (sa.position(at.a.index) + sb.position(at.b.index)) - center_mm;
+    if (mid.dot(n) < 0.0 || mid.squaredNorm() > radius_mm * radius_mm) continue;
+    at.cut = true;
+    sa.wake_vertex(at.a.index);
+    sb.wake_vertex(at.b.index);
+    ++severed;
+  }
+  return severed;
 }
 
 bool TissueWorld::attachment_holds(std::uint32_t i) const {

@@ -88,6 +88,12 @@ struct AttachmentDescription {
   Vec3 world_point_mm = Vec3::Zero();  // used when surface_b == kWorld
   double stiffness_un_per_mm = 1e4;    // µN/mm; large values approach a rigid weld
   double break_force_un = std::numeric_limits<double>::infinity();
+  // 0: the two ends coincide (instance vertices: a membrane lying on the retina, held where it
+  // lies). > 0 (surface to surface only): a stalk of this length between the two layers — a
+  // fibrovascular peg holding an elevated membrane off the retina — pulling when stretched and
+  // pushing when compressed along the line between its ends. A stalk is a bridge an instrument can
+  // reach: cut_attachments_in() severs it; a coincident attachment goes only with its tissue.
+  double rest_length_mm = 0.0;
 };
 
 // A force per unit area (Pa) on a set of vertices toward a point: the thesis' detachment force
@@ -256,6 +262,12 @@ class TissueWorld {
   bool attachment_intact(std::uint32_t i) const { return attachments_.at(i).intact; }
   // Intact and both ends still exist (a removed or cut-away end is only marked broken at the next step).
   bool attachment_holds(std::uint32_t i) const;
+  // Severs every intact stalk (an attachment with a rest length, both ends on surfaces) whose
+  // midpoint lies in the hemisphere of `radius_mm` about `center_mm` on the side `normal` points to
+  // — what a vitrector's cut reaches in front of its port. The attachments break at the next step
+  // boundary, reported like any broken attachment (magnitude: the force they last carried), and
+  // their ends are woken. Returns how many it severed.
+  std::uint32_t cut_attachments_in(const Vec3& center_mm, const Vec3& normal, double radius_mm);
   // Force the attachment carried during the last step (µN): the constraint multiplier over h².
   double attachment_force(std::uint32_t i) const { return attachments_.at(i).last_force_un; }
   double attachment_break_force(std::uint32_t i) const { return attachments_.at(i).d.break_force_un; }
@@ -292,6 +304,7 @@ class TissueWorld {
     AttachmentDescription d;
     VertexId a, b;
     bool intact = true;
+    bool cut = false;  // severed by an instrument since the last step boundary (cut_attachments_in)
     double last_force_un = 0.0;
     double peak_force_un = 0.0;
   };
@@ -335,7 +348,7 @@ class TissueWorld {
     std::array<double, 3> b{};
     Vec3 target = Vec3::Zero();
     Vec3 normal = Vec3::Zero();                 // contacts: the push direction
-    double offset = 0.0;                        // contacts: the capsule radius
+    double offset = 0.0;                        // contacts: the capsule radius; attachments: the stalk's rest length
     double k = 0.0;
     Vec3 point(const TissueWorld& w) const;     // p with the current positions
   };

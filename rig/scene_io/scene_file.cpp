@@ -445,6 +445,7 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     t.number("weak_break_force_un", s.weak_break_force_un);
     t.number("strong_break_force_un", s.strong_break_force_un);
     t.number("detach_radius_mm", s.detach_radius_mm);
+    t.number("elevation_mm", s.elevation_mm);
     t.finish();
     check_item(t, [&](core::SceneDescription& p) { p.membranes = {s}; });
     d.membranes.push_back(s);

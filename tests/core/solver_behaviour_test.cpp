@@ -416,3 +416,108 @@ TEST(SolverBehaviour, PlasticityKeepsAReleasedMembraneNearWhereItWasLeft) {
   EXPECT_LT(elastic, 0.3) << "without plasticity the membrane springs back";
   EXPECT_GT(plastic, 1.0) << "with plasticity it stays roughly where it was left";
 }
+
+namespace {
+
+// Two triangles 1 mm on a side, the lower one fixed at z = 0, the upper one free above it at
+// `start_gap_mm`, joined corner to corner by stalks of `stalk_mm` (k = 1000 µN/mm); no gravity, no
+// pressure. The upper triangle is pulled up by a local force of `pull_un` in all.
+struct StalkedLayers {
+  TissueWorld world{far_wall(), [] {
+                      Environment env;
+                      env.gravity_mm_s2 = Vec3::Zero();
+                      env.apply_pressure = false;
+                      return env;
+                    }()};
+  std::uint32_t lower = 0, upper = 0;
+  std::vector<std::uint32_t> stalks;
+  static constexpr double kStiffness = 1000.0;
+
+  StalkedLayers(double start_gap_mm, double stalk_mm, double pull_un) {
+    SurfaceDescription d;
+    d.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    d.mesh.triangles = {{0, 1, 2}};
+    d.contained_by_globe = false;
+    lower = world.add_surface(d);
+    for (auto& p : d.mesh.positions) p.z() = start_gap_mm;
+    upper = world.add_surface(d);
+    Surface& l = world.surface(lower);
+    for (std::uint32_t v = 0; v < 3; ++v) EXPECT_TRUE(l.set_fixed(l.vertex_id(v), true));
+    for (std::uint32_t v = 0; v < 3; ++v) {
+      AttachmentDescription a;
+      a.surface_a = upper;
+      a.vertex_a = v;
+      a.surface_b = lower;
+      a.vertex_b = v;
+      a.stiffness_un_per_mm = kStiffness;
+      a.rest_length_mm = stalk_mm;
+      stalks.push_back(world.add_attachment(a));
+    }
+    if (pull_un > 0.0) {
+      LocalForceDescription f;
+      f.name = "pull";
+      f.surface = upper;
+      f.vertices = {0, 1, 2};
+      f.toward_point_mm = Vec3(1.0 / 3.0, 1.0 / 3.0, 1e9);
+      f.pressure_pa = pull_un / 0.5;  // over the triangle's 0.5 mm²: µN / mm² = Pa
+      world.add_local_force(f);
+    }
+  }
+  double gap(std::uint32_t v) const { return world.surface(upper).position(v).z() - world.surface(lower).position(v).z(); }
+};
+
+}  // namespace
+
+TEST(SolverBehaviour, AStalkHoldsTwoLayersApartAtItsLengthAndStretchesByHookesLaw) {
+  // Started compressed (0.2 mm on 0.5 mm stalks), the upper layer is pushed back out to the stalks'
+  // length; pulled by 300 µN, each of the three stalks carries 100 µN and stretches F/k = 0.1 mm.
+  StalkedLayers free_layers(0.2, 0.5, 0.0);
+  for (int i = 0; i < 2000; ++i) ASSERT_TRUE(free_layers.world.step(1e-3).ok);
+  for (std::uint32_t v = 0; v < 3; ++v) EXPECT_NEAR(free_layers.gap(v), 0.5, 1e-3) << "corner " << v;
+
+  StalkedLayers pulled(0.5, 0.5, 300.0);
+  for (int i = 0; i < 3000; ++i) ASSERT_TRUE(pulled.world.step(1e-3).ok);
+  for (std::uint32_t v = 0; v < 3; ++v) {
+    EXPECT_NEAR(pulled.gap(v), 0.5 + 100.0 / StalkedLayers::kStiffness, 2e-3) << "corner " << v;
+    EXPECT_NEAR(pulled.world.attachment_force(pulled.stalks[v]), 100.0, 2.0) << "corner " << v;
+  }
+}
+
+TEST(SolverBehaviour, ACutSeversTheStalksInItsReachAndNothingElse) {
+  StalkedLayers layers(0.5, 0.5, 0.0);
+  // A coincident attachment (a membrane lying on the retina) at corner 0 beside the stalk.
+  AttachmentDescription coincident;
+  coincident.surface_a = layers.upper;
+  coincident.vertex_a = 0;
+  coincident.surface_b = layers.lower;
+  coincident.vertex_b = 1;  // any vertex: it is the rest length that makes a stalk
+  coincident.stiffness_un_per_mm = 1.0;
+  const std::uint32_t flat = layers.world.add_attachment(coincident);
+  for (int i = 0; i < 100; ++i) ASSERT_TRUE(layers.world.step(1e-3).ok);
+
+  // A hemisphere of 0.3 mm about a point 0.1 mm beside corner 0's stalk, at its mid-height, facing
+  // it: the stalk's midpoint (0, 0, 0.25) is inside; corners 1 and 2 are 1 mm away.
+  EXPECT_EQ(layers.world.cut_attachments_in({-0.1, 0.0, 0.25}, {1, 0, 0}, 0.3), 1u);
+  // Facing away, the same point reaches nothing; a second call does not count the cut one again.
+  EXPECT_EQ(layers.world.cut_attachments_in({0.1, 0.0, 0.25}, {1, 0, 0}, 0.3), 0u);
+  EXPECT_EQ(layers.world.cut_attachments_in({-0.1, 0.0, 0.25}, {1, 0, 0}, 0.3), 0u);
+  EXPECT_TRUE(layers.world.attachment_intact(layers.stalks[0])) << "it breaks at the step boundary";
+
+  const StepReport r = layers.world.step(1e-3);
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.attachments_broken, 1u);
+  EXPECT_FALSE(layers.world.attachment_holds(layers.stalks[0]));
+  EXPECT_TRUE(layers.world.attachment_holds(layers.stalks[1]));
+  EXPECT_TRUE(layers.world.attachment_holds(layers.stalks[2]));
+  EXPECT_TRUE(layers.world.attachment_holds(flat)) << "a coincident attachment goes only with its tissue";
+
+  // Refused: a stalk to a world point, a negative length.
+  AttachmentDescription bad;
+  bad.surface_a = layers.upper;
+  bad.vertex_a = 1;
+  bad.rest_length_mm = 0.5;
+  EXPECT_THROW(layers.world.add_attachment(bad), InvalidArgument);
+  bad.surface_b = layers.lower;
+  bad.rest_length_mm = -0.1;
+  EXPECT_THROW(layers.world.add_attachment(bad), InvalidArgument);
+}

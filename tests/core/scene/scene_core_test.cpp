@@ -317,3 +317,52 @@ TEST(StateIo, ValuesAreValidatedBeforeAnythingIsApplied) {
 
 }  // namespace
 }  // namespace vitreo::core
+
+namespace vitreo::core {
+
+TEST(SceneBuilder, AnElevatedBandStandsOnStalksOfItsElevation) {
+  // A circumferential band 0.4 mm off the retina: every band vertex stands about that far inside
+  // the retina it was copied from, and its attachments are stalks of that length — at the build
+  // they carry nothing (zero-length attachments there would each pull 2e3 µN/mm × 0.4 mm).
+  SceneDescription d;
+  d.name = "band";
+  d.anatomy = small_eye();
+  d.anatomy.retina_vertices = 6000;
+  d.texture_size_px = 128;
+  d.materials = default_materials();
+  MembraneSpec band;
+  band.name = "band";
+  band.kind = MembraneKind::kCircumferential;
+  band.center = {45.0, 180.0};
+  band.size_mm = 6.0;
+  band.width_mm = 1.6;
+  band.rest_length_scale = 1.0;
+  band.attachment_stride = 2;
+  band.elevation_mm = 0.4;
+  d.membranes.push_back(band);
+  d.settle.min_steps = 0;
+  d.settle.max_steps = 0;  // as built
+  Scene s = build_scene(d);
+  ASSERT_EQ(s.membranes.size(), 1u);
+  const BuiltMembrane& m = s.membranes[0];
+  ASSERT_GT(m.attachment_count, 5u);
+  const Surface& b = s.world.surface(m.surface);
+  const Surface& r = s.world.surface(s.retina);
+  for (std::uint32_t v = 0; v < b.vertex_slots(); ++v) {
+    if (!b.vertex_alive(v)) continue;
+    double nearest = 1e9;  // the retina vertex under it: the nearest one
+    for (std::uint32_t w = 0; w < r.vertex_slots(); ++w) {
+      if (r.vertex_alive(w)) nearest = std::min(nearest, (r.position(w) - b.position(v)).norm());
+    }
+    EXPECT_NEAR(nearest, 0.4, 1e-6) << "band vertex " << v;
+  }
+  ASSERT_TRUE(s.world.step(1e-3).ok);
+  for (std::uint32_t a = m.first_attachment; a < m.first_attachment + m.attachment_count; ++a) {
+    EXPECT_LT(s.world.attachment_force(a), 5.0) << "attachment " << a;
+  }
+  // Only bands stand off the retina.
+  d.membranes[0].kind = MembraneKind::kEpiretinal;
+  EXPECT_THROW(d.validate(), InvalidArgument);
+}
+
+}  // namespace vitreo::core
