@@ -171,7 +171,6 @@ void TissueWorld::add_point_terms(double fraction) {
     t.kind = PointKind::kAttachment;
     t.owner = i;
     t.k = at.d.stiffness_un_per_mm;
-    t.offset = at.d.rest_length_mm;
     t.surface[0] = at.d.surface_a;
     t.vertex[0] = at.a.index;
     t.b[0] = 1.0;
@@ -183,6 +182,13 @@ void TissueWorld::add_point_terms(double fraction) {
       t.vertex[1] = at.b.index;
       t.b[1] = -1.0;
       t.count = 2;
+      if (at.d.rest_length_mm > 0.0) {
+        // A stalk: surface_a's end is held at rest_length_mm inward of its base (toward the globe's
+        // centre, fixed for the substep), so the stalk keeps the layers apart and passes shear on.
+        const Vec3 inward = wall_.center() - surfaces_[at.d.surface_b]->position(at.b.index);
+        const double n = inward.norm();
+        if (n > 1e-9) t.target = inward * (at.d.rest_length_mm / n);
+      }
     }
     add_point_term(t);
   }

@@ -251,16 +251,6 @@ void TissueWorld::sweep_vertices(double h) {
           touching = true;
           f -= (t.k * b * gap) * t.normal;
           add_outer(H, t.k * b * b, t.normal);
-        } else if (t.offset > 0.0) {
-          // A stalk (an attachment with a rest length): a spring between the two points, its
-          // Hessian's transverse part clamped at 0 when compressed, as for the springs above.
-          const double len = off.norm();
-          if (len < 1e-12) continue;
-          const Vec3 dir = off / len;
-          const double transverse = std::max(0.0, 1.0 - t.offset / len);
-          f -= (t.k * b * (len - t.offset)) * dir;
-          add_diagonal(H, t.k * b * b * transverse);
-          add_outer(H, t.k * b * b * (1.0 - transverse), dir);
         } else {
           f -= (t.k * b) * off;
           add_diagonal(H, t.k * b * b);
@@ -332,7 +322,7 @@ void TissueWorld::measure_point_forces(double fraction_of_step) {
     switch (t.kind) {
       case PointKind::kAttachment: {
         Attachment& at = attachments_[t.owner];
-        at.last_force_un = t.k * std::abs(off.norm() - t.offset);
+        at.last_force_un = t.k * off.norm();
         at.peak_force_un = std::max(at.peak_force_un, at.last_force_un);
         break;
       }

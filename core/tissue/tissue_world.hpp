@@ -90,9 +90,11 @@ struct AttachmentDescription {
   double break_force_un = std::numeric_limits<double>::infinity();
   // 0: the two ends coincide (instance vertices: a membrane lying on the retina, held where it
   // lies). > 0 (surface to surface only): a stalk of this length between the two layers — a
-  // fibrovascular peg holding an elevated membrane off the retina — pulling when stretched and
-  // pushing when compressed along the line between its ends. A stalk is a bridge an instrument can
-  // reach: cut_attachments_in() severs it; a coincident attachment goes only with its tissue.
+  // fibrovascular peg holding an elevated membrane off the retina: surface_a's end is held this far
+  // inward of surface_b's (toward the globe's centre), so it keeps the layers apart and passes the
+  // membrane's pull on to the retina as a coincident attachment does. A stalk is a bridge an
+  // instrument can reach: cut_attachments_in() severs it; a coincident attachment goes only with
+  // its tissue.
   double rest_length_mm = 0.0;
 };
 
@@ -348,7 +350,7 @@ class TissueWorld {
     std::array<double, 3> b{};
     Vec3 target = Vec3::Zero();
     Vec3 normal = Vec3::Zero();                 // contacts: the push direction
-    double offset = 0.0;                        // contacts: the capsule radius; attachments: the stalk's rest length
+    double offset = 0.0;                        // contacts: the capsule radius
     double k = 0.0;
     Vec3 point(const TissueWorld& w) const;     // p with the current positions
   };

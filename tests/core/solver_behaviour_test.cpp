@@ -421,9 +421,10 @@ namespace {
 
 // Two triangles 1 mm on a side, the lower one fixed at z = 0, the upper one free above it at
 // `start_gap_mm`, joined corner to corner by stalks of `stalk_mm` (k = 1000 µN/mm); no gravity, no
-// pressure. The upper triangle is pulled up by a local force of `pull_un` in all.
+// pressure; the globe's centre 100 mm up, so "inward" is +z (within 0.6°). The upper triangle is
+// pulled up by a local force of `pull_un` in all.
 struct StalkedLayers {
-  TissueWorld world{far_wall(), [] {
+  TissueWorld world{GlobeWall::sphere(Vec3(0, 0, 100), 101), [] {
                       Environment env;
                       env.gravity_mm_s2 = Vec3::Zero();
                       env.apply_pressure = false;
@@ -474,6 +475,18 @@ TEST(SolverBehaviour, AStalkHoldsTwoLayersApartAtItsLengthAndStretchesByHookesLa
   StalkedLayers free_layers(0.2, 0.5, 0.0);
   for (int i = 0; i < 2000; ++i) ASSERT_TRUE(free_layers.world.step(1e-3).ok);
   for (std::uint32_t v = 0; v < 3; ++v) EXPECT_NEAR(free_layers.gap(v), 0.5, 1e-3) << "corner " << v;
+
+  // A stalk resists shear as a coincident attachment does: the upper layer pushed 0.2 mm sideways
+  // comes back over its base.
+  Surface& up = free_layers.world.surface(free_layers.upper);
+  for (std::uint32_t v = 0; v < 3; ++v) ASSERT_TRUE(up.set_position(up.vertex_id(v), up.position(v) + Vec3(0.2, 0, 0)));
+  for (int i = 0; i < 2000; ++i) ASSERT_TRUE(free_layers.world.step(1e-3).ok);
+  for (std::uint32_t v = 0; v < 3; ++v) {
+    const Vec3 d = up.position(v) - free_layers.world.surface(free_layers.lower).position(v);
+    // Over its base up to the stalk's lean toward the globe's centre (0.5 mm × 1/100 at corner 1).
+    EXPECT_LT(std::abs(d.x()), 0.01) << "corner " << v;
+    EXPECT_LT(std::abs(d.y()), 0.01) << "corner " << v;
+  }
 
   StalkedLayers pulled(0.5, 0.5, 300.0);
   for (int i = 0; i < 3000; ++i) ASSERT_TRUE(pulled.world.step(1e-3).ok);

@@ -1051,7 +1051,7 @@ TEST(Instruments, TheVitrectorsGuillotineSeversTheStalksInItsReach) {
   // A port 0.1 mm beside corner 0's stalk, facing it, low enough that the upper layer is out of the
   // removal hemisphere: with the cutter off nothing happens; cutting, that stalk is severed — and
   // only it — and nothing of the upper layer is removed.
-  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 1e6), no_pressure(), no_sleep());
+  TissueWorld world(GlobeWall::sphere(Vec3(0, 0, 100), 101), no_pressure(), no_sleep());  // inward: +z
   SurfaceDescription d;
   d.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   d.mesh.triangles = {{0, 1, 2}};
