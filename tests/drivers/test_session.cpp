@@ -120,7 +120,12 @@ TEST(Session, RefusesDeviceWithOtherProtocolMajor) {
   h.s.transport_up(0);
   h.info(1000, 2);
   EXPECT_EQ(h.s.state(), LinkState::connecting);
-  EXPECT_EQ(h.s.stats().version_errors, 1u);
+  // A valid frame refused for what it says, not a frame of another version: counted apart, and
+  // the refusal names both versions (device_status_t shows it as ERROR with this detail).
+  EXPECT_EQ(h.s.stats().protocol_rejected, 1u);
+  EXPECT_EQ(h.s.stats().version_errors, 0u);
+  EXPECT_NE(h.s.refusal().find("protocol 2."), std::string::npos) << h.s.refusal();
+  EXPECT_NE(h.s.refusal().find("this host 1."), std::string::npos) << h.s.refusal();
   EXPECT_FALSE(h.s.has_device_info());
 }
 
