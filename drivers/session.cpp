@@ -114,6 +114,12 @@ std::uint16_t DeviceSession::configured_rate_hz() const {
   return have_info_ ? nominal_sample_rate_hz(info_.device_type) : 0;
 }
 
+std::uint64_t DeviceSession::stale_after_us() const {
+  const std::uint16_t rate = configured_rate_hz();
+  const std::uint64_t periods = rate ? 20'000'000u / rate : 0;
+  return periods > cfg_.stale_after_us ? periods : cfg_.stale_after_us;
+}
+
 void DeviceSession::send(vp_message m) {
   m.seq = tx_seq_++;
   m.version_minor = VP_PROTO_MINOR;
@@ -388,7 +394,7 @@ bool DeviceSession::tick(std::uint64_t now_us) {
       }
       break;
     case LinkState::streaming:
-      if (now_us - last_sample_us_ > cfg_.stale_after_us) set_state(LinkState::stale, now_us, "samples late");
+      if (now_us - last_sample_us_ > stale_after_us()) set_state(LinkState::stale, now_us, "samples late");
       [[fallthrough]];
     case LinkState::stale:
       // The device's heartbeat (10 Hz) missing while it streams: one miss per gap of two periods.

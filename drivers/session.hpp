@@ -131,7 +131,9 @@ class ClockMapper {
 };
 
 struct SessionConfig {
-  std::uint64_t stale_after_us = 20'000;       // no sample for this long: stale (20 periods at 1 kHz)
+  // No sample for this long, or for 20 periods of the configured rate when that is longer: stale
+  // (20 ms at a tracker's 1 kHz, 40 ms at the pedals' 500 Hz, 80 ms at the eyeball's 250 Hz).
+  std::uint64_t stale_after_us = 20'000;
   std::uint64_t lost_after_us = 250'000;       // no valid frame for this long: lost
   std::uint64_t retry_us = 50'000;             // identify/configure retransmission
   std::uint64_t reconnect_interval_us = 100'000;
@@ -201,6 +203,8 @@ class DeviceSession {
   std::uint64_t last_sample_us() const { return last_sample_us_; }
   // The rate configured for the device (0 before it identified, when the nominal rate applies).
   std::uint16_t configured_rate_hz() const;
+  // How long without a sample makes the link stale (SessionConfig::stale_after_us).
+  std::uint64_t stale_after_us() const;
 
  private:
   void set_state(LinkState s, std::uint64_t now_us, const char* why);
