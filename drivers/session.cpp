@@ -101,9 +101,29 @@ void DeviceSession::set_state(LinkState s, std::uint64_t now_us, const char* why
   if (on_state_) on_state_(from, s, why);
 }
 
+std::uint16_t nominal_sample_rate_hz(std::uint8_t device_type) {
+  switch (device_type) {
+    case VP_DEVICE_PEDAL: return 500;
+    case VP_DEVICE_EYEBALL: return 250;
+    default: return 1000;  // a tracker, per instrument
+  }
+}
+
+std::uint16_t DeviceSession::configured_rate_hz() const {
+  if (cfg_.sample_rate_hz != 0) return cfg_.sample_rate_hz;
+  return have_info_ ? nominal_sample_rate_hz(info_.device_type) : 0;
+}
+
+std::uint64_t DeviceSession::stale_after_us() const {
+  const std::uint16_t rate = configured_rate_hz();
+  const std::uint64_t periods = rate ? 20'000'000u / rate : 0;
+  return periods > cfg_.stale_after_us ? periods : cfg_.stale_after_us;
+}
+
 void DeviceSession::send(vp_message m) {
   m.seq = tx_seq_++;
   m.version_minor = VP_PROTO_MINOR;
+  ++stats_.frames_tx;
   if (send_) send_(m);
 }
 
@@ -117,7 +137,7 @@ void DeviceSession::send_identify() {
 void DeviceSession::send_configure(std::uint64_t now_us) {
   vp_message m{};
   m.type = VP_MSG_CONFIG;
-  m.u.config = {VP_CFG_SET, VP_CFG_KEY_SAMPLE_RATE_HZ, cfg_.sample_rate_hz};
+  m.u.config = {VP_CFG_SET, VP_CFG_KEY_SAMPLE_RATE_HZ, configured_rate_hz()};
   send(m);
   m.u.config = {VP_CFG_SET, VP_CFG_KEY_STREAMING, 1};
   send(m);
@@ -141,8 +161,11 @@ void DeviceSession::transport_up(std::uint64_t now_us) {
   last_host_us_ = 0;
   last_payload_.clear();
   stuck_ = false;
+  refusal_.clear();
+  last_sample_us_ = 0;
   clock_.reset();
   last_frame_us_ = now_us;
+  last_heartbeat_us_ = now_us;
   set_state(LinkState::connecting, now_us, "transport open");
   send_identify();
   next_retry_us_ = now_us + cfg_.retry_us;
@@ -198,8 +221,12 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       if (m.u.device_info.proto_major != VP_PROTO_MAJOR) {
         // the frame itself parsed (frames carry their own version), but the device announces a
         // protocol we do not speak: refuse to configure it rather than guess
-        ++stats_.version_errors;
-        last_error_ = "device announces an unsupported protocol major version";
+        ++stats_.protocol_rejected;
+        char why[128];
+        std::snprintf(why, sizeof why, "device speaks protocol %u.%u, this host %u.%u: not configured",
+                      static_cast<unsigned>(m.u.device_info.proto_major), static_cast<unsigned>(m.u.device_info.proto_minor),
+                      static_cast<unsigned>(VP_PROTO_MAJOR), static_cast<unsigned>(VP_PROTO_MINOR));
+        last_error_ = refusal_ = why;
         return;
       }
       if ((cfg_.expected_device_type != 0 && m.u.device_info.device_type != cfg_.expected_device_type) ||
@@ -209,9 +236,10 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
         std::snprintf(why, sizeof why, "device is type %u serial %u, expected type %u serial %u (0 = any)",
                       static_cast<unsigned>(m.u.device_info.device_type), static_cast<unsigned>(m.u.device_info.serial),
                       static_cast<unsigned>(cfg_.expected_device_type), static_cast<unsigned>(cfg_.expected_serial));
-        last_error_ = why;
+        last_error_ = refusal_ = why;
         return;
       }
+      refusal_.clear();
       info_ = m.u.device_info;
       have_info_ = true;
       if (recovering_) {
@@ -284,6 +312,7 @@ void DeviceSession::handle(const vp_message& m, std::uint64_t now_us) {
       return;
     }
     default:  // heartbeat, calibration results: keep the link alive, handed to the message hook
+      if (m.type == VP_MSG_HEARTBEAT) last_heartbeat_us_ = now_us;
       if (on_message_) on_message_(m);
       return;
   }
@@ -365,9 +394,14 @@ bool DeviceSession::tick(std::uint64_t now_us) {
       }
       break;
     case LinkState::streaming:
-      if (now_us - last_sample_us_ > cfg_.stale_after_us) set_state(LinkState::stale, now_us, "samples late");
+      if (now_us - last_sample_us_ > stale_after_us()) set_state(LinkState::stale, now_us, "samples late");
       [[fallthrough]];
     case LinkState::stale:
+      // The device's heartbeat (10 Hz) missing while it streams: one miss per gap of two periods.
+      if (now_us - last_heartbeat_us_ > cfg_.heartbeat_miss_us) {
+        ++stats_.heartbeat_misses;
+        last_heartbeat_us_ = now_us;
+      }
       if (now_us >= next_sync_us_) {
         vp_message m{};
         m.type = VP_MSG_TIME_SYNC;

@@ -78,6 +78,7 @@ const char* to_string(LinkState s);
 struct LinkStats {
   std::uint64_t bytes = 0;            // raw bytes (serial) or transfers' bytes (USB/CAN)
   std::uint64_t frames = 0;           // frames seen, valid or not
+  std::uint64_t frames_tx = 0;        // messages the host sent the device (identify, configure, time sync, calibration)
   std::uint64_t valid = 0;            // frames that decoded and validated
   std::uint64_t crc_errors = 0;
   std::uint64_t framing_errors = 0;   // COBS/CAN framing, overflow, segment sequence, truncation
@@ -90,9 +91,11 @@ struct LinkStats {
   std::uint64_t stuck_samples = 0;   // samples delivered while stuck
   std::uint64_t stuck_episodes = 0;  // times the sensor became stuck
   std::uint64_t identity_rejected = 0;  // DEVICE_INFO of another kind or serial than the rig expects
+  std::uint64_t protocol_rejected = 0;  // DEVICE_INFO announcing a protocol major version the host does not speak
   std::uint64_t samples_delivered = 0;
   std::uint64_t disconnects = 0;
   std::uint64_t reconnects = 0;       // the device identified itself again after a loss
+  std::uint64_t heartbeat_misses = 0; // streaming, yet no HEARTBEAT for more than heartbeat_miss_us
   std::uint64_t latency_count = 0;
   std::uint64_t latency_last_us = 0;
   std::uint64_t latency_max_us = 0;
@@ -128,13 +131,18 @@ class ClockMapper {
 };
 
 struct SessionConfig {
-  std::uint64_t stale_after_us = 20'000;       // no sample for this long: stale (20 periods at 1 kHz)
+  // No sample for this long, or for 20 periods of the configured rate when that is longer: stale
+  // (20 ms at a tracker's 1 kHz, 40 ms at the pedals' 500 Hz, 80 ms at the eyeball's 250 Hz).
+  std::uint64_t stale_after_us = 20'000;
   std::uint64_t lost_after_us = 250'000;       // no valid frame for this long: lost
   std::uint64_t retry_us = 50'000;             // identify/configure retransmission
   std::uint64_t reconnect_interval_us = 100'000;
   std::uint64_t time_sync_interval_us = 1'000'000;
   std::uint64_t jump_tolerance_us = 100'000;   // device timestamp step counted as a jump
-  std::uint16_t sample_rate_hz = 1000;
+  std::uint64_t heartbeat_miss_us = 200'000;   // two periods of the protocol's 10 Hz heartbeat
+  // The rate the host configures; 0: the protocol's nominal rate for the device type that
+  // identified itself (PROTOCOL.md §7: tracker 1000 Hz, pedals 500 Hz, eyeball fixture 250 Hz).
+  std::uint16_t sample_rate_hz = 0;
   // A pose (tracker) or orientation (eyeball fixture) bit-identical for this long of the device's
   // own time is a frozen sensor: a real one always jitters. Samples whose timestamps do not advance
   // are repeats, not evidence. Pedals at rest legitimately repeat, so they are not checked.
@@ -187,6 +195,16 @@ class DeviceSession {
   const SessionConfig& config() const { return cfg_; }
   std::uint64_t next_reconnect_us() const { return next_reconnect_us_; }
   const std::string& last_error() const { return last_error_; }
+  // The device at this address was refused — another kind or serial than expected, or a protocol
+  // major version the host does not speak — and is not configured; refusal() says why (empty when
+  // it was not). Cleared when the transport comes up again.
+  const std::string& refusal() const { return refusal_; }
+  // Host time the last sample was delivered (0: none yet on this link).
+  std::uint64_t last_sample_us() const { return last_sample_us_; }
+  // The rate configured for the device (0 before it identified, when the nominal rate applies).
+  std::uint16_t configured_rate_hz() const;
+  // How long without a sample makes the link stale (SessionConfig::stale_after_us).
+  std::uint64_t stale_after_us() const;
 
  private:
   void set_state(LinkState s, std::uint64_t now_us, const char* why);
@@ -210,7 +228,7 @@ class DeviceSession {
   bool configured_ = false;
   bool recovering_ = false;  // the transport was re-opened after a loss; the device not identified yet
   ClockMapper clock_;
-  std::uint64_t last_frame_us_ = 0, last_sample_us_ = 0, state_since_us_ = 0;
+  std::uint64_t last_frame_us_ = 0, last_sample_us_ = 0, state_since_us_ = 0, last_heartbeat_us_ = 0;
   std::uint64_t next_retry_us_ = 0, next_sync_us_ = 0, next_reconnect_us_ = 0;
   std::uint64_t last_device_us_ = 0, last_host_us_ = 0;
   bool have_device_us_ = false;
@@ -223,6 +241,10 @@ class DeviceSession {
   std::uint64_t same_since_device_us_ = 0;
   bool stuck_ = false;
   std::string last_error_;
+  std::string refusal_;
 };
+
+// PROTOCOL.md §7's nominal sample rate of a device type (vp_device_type); 1000 for an unknown one.
+std::uint16_t nominal_sample_rate_hz(std::uint8_t device_type);
 
 }  // namespace vitreo::drivers

@@ -365,7 +365,8 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
         const double raw = im.pedal_lo[a] == 0 && im.pedal_hi[a] == 1 ? travel : im.pedal_lo[a] + (im.pedal_hi[a] - im.pedal_lo[a]) * travel;
         p.axes[a] = static_cast<std::uint16_t>(raw * 65535.0 + 0.5);
       }
-      p.switches = static_cast<std::uint16_t>(v[2]);
+      // A script may say anything up to ±1e6 (parse_script): the switch word is 16 bits.
+      p.switches = static_cast<std::uint16_t>(std::clamp(v[2], 0.0, 65535.0));
       break;
     }
     case DeviceKind::eyeball: {

@@ -7,7 +7,7 @@
 
 #include "core/metrics/score_card.hpp"
 #include "rig/report/json_writer.hpp"
-#include "rig/session/event_keys.hpp"
+#include "rig/telemetry/event_keys.hpp"
 
 namespace vitreo::report {
 
@@ -93,7 +93,7 @@ core::SessionTotals as_core_totals(const TotalsRecord& t) {
   c.time_over_force_limit_s = t.time_over_force_limit_s;
   c.force_limit_un = t.force_limit_un;
   for (std::size_t k = 0; k < core::kInstrumentEventKinds; ++k)
-    c.events[k] = static_cast<std::uint32_t>(std::max(0, event_count(t, rig::event_key(static_cast<core::InstrumentEventKind>(k)))));
+    c.events[k] = static_cast<std::uint32_t>(std::max(0, event_count(t, telemetry::event_key(static_cast<core::InstrumentEventKind>(k)))));
   c.burns_on_target = static_cast<std::uint32_t>(t.burns_on_target);
   c.burns_elsewhere = static_cast<std::uint32_t>(t.burns_elsewhere);
   c.retina_tears = static_cast<std::uint32_t>(t.retina_tears);

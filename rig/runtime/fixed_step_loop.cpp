@@ -10,7 +10,9 @@ FixedStepLoop::FixedStepLoop(Clock& clock, LoopConfig config, StepFn step)
       config_(config),
       step_(std::move(step)),
       step_hist_(config.histogram_bucket_ns, config.histogram_buckets),
-      jitter_hist_(config.histogram_bucket_ns, config.histogram_buckets) {
+      jitter_hist_(config.histogram_bucket_ns, config.histogram_buckets),
+      window_step_hist_(config.histogram_bucket_ns, config.histogram_buckets),
+      window_jitter_hist_(config.histogram_bucket_ns, config.histogram_buckets) {
   if (config_.period_ns <= 0) throw std::invalid_argument("FixedStepLoop: period_ns must be > 0");
   if (!step_) throw std::invalid_argument("FixedStepLoop: no step function");
 }
@@ -48,12 +50,14 @@ std::uint64_t FixedStepLoop::run(std::uint64_t max_steps) {
       consecutive_late_ = 0;
     }
     jitter_hist_.record(lateness);
+    window_jitter_hist_.record(lateness);
 
     const std::uint64_t index = next_index_.load(std::memory_order_relaxed);
     const std::int64_t t0 = clock_.now_ns();
     step_(index, static_cast<double>(index) * period_s);
     const std::int64_t dt = clock_.now_ns() - t0;
     step_hist_.record(dt);
+    window_step_hist_.record(dt);
     if (dt > period) ++counters_.overruns;
     ++counters_.steps;
     next_index_.store(index + 1, std::memory_order_relaxed);
@@ -63,22 +67,33 @@ std::uint64_t FixedStepLoop::run(std::uint64_t max_steps) {
   return ran;
 }
 
-LoopStats FixedStepLoop::stats() const {
-  LoopStats s = counters_;
-  s.window_steps = step_hist_.count();
-  s.step_p50_ns = step_hist_.quantile_ns(0.5);
-  s.step_p99_ns = step_hist_.quantile_ns(0.99);
-  s.step_max_ns = step_hist_.max_ns();
-  s.step_mean_ns = step_hist_.mean_ns();
-  s.jitter_p50_ns = jitter_hist_.quantile_ns(0.5);
-  s.jitter_p99_ns = jitter_hist_.quantile_ns(0.99);
-  s.jitter_max_ns = jitter_hist_.max_ns();
+namespace {
+LoopStats with_histograms(LoopStats s, const DurationHistogram& step, const DurationHistogram& jitter) {
+  s.window_steps = step.count();
+  s.step_p50_ns = step.quantile_ns(0.5);
+  s.step_p99_ns = step.quantile_ns(0.99);
+  s.step_max_ns = step.max_ns();
+  s.step_mean_ns = step.mean_ns();
+  s.jitter_p50_ns = jitter.quantile_ns(0.5);
+  s.jitter_p99_ns = jitter.quantile_ns(0.99);
+  s.jitter_max_ns = jitter.max_ns();
   return s;
+}
+}  // namespace
+
+LoopStats FixedStepLoop::stats() const { return with_histograms(counters_, step_hist_, jitter_hist_); }
+
+LoopStats FixedStepLoop::window_stats() const { return with_histograms(counters_, window_step_hist_, window_jitter_hist_); }
+
+void FixedStepLoop::start_window() noexcept {
+  window_step_hist_.reset();
+  window_jitter_hist_.reset();
 }
 
 void FixedStepLoop::reset_histograms() noexcept {
   step_hist_.reset();
   jitter_hist_.reset();
+  start_window();
 }
 
 }  // namespace vitreo::runtime

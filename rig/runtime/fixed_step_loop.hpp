@@ -35,7 +35,8 @@ struct LoopConfig {
 
 struct LoopStats {
   std::uint64_t steps = 0;          // cumulative, like the counters below
-  std::uint64_t window_steps = 0;   // steps in the histograms (since the last reset_histograms())
+  std::uint64_t window_steps = 0;   // steps in the histograms: stats() since the start (or reset_histograms()),
+                                    // window_stats() since the last start_window()
   std::uint64_t overruns = 0;       // steps whose duration exceeded the period
   std::uint64_t late_steps = 0;     // steps started >= one period after their deadline (caught up)
   std::uint64_t dropped_steps = 0;  // deadlines skipped by backlog drops
@@ -62,7 +63,11 @@ class FixedStepLoop {
   LoopStats stats() const;
   const DurationHistogram& step_histogram() const noexcept { return step_hist_; }
   const DurationHistogram& jitter_histogram() const noexcept { return jitter_hist_; }
-  void reset_histograms() noexcept;
+  void reset_histograms() noexcept;  // both the session's and the window's
+  // The same statistics over the steps since the last start_window() (the counters stay
+  // cumulative): what one physics_timing_t reports, while stats() keeps the whole session's.
+  LoopStats window_stats() const;
+  void start_window() noexcept;
   // Index of the next step to run; readable from any thread.
   std::uint64_t next_step_index() const noexcept { return next_index_.load(std::memory_order_relaxed); }
   const LoopConfig& config() const noexcept { return config_; }
@@ -79,6 +84,7 @@ class FixedStepLoop {
   LoopStats counters_;
   DurationHistogram step_hist_;
   DurationHistogram jitter_hist_;
+  DurationHistogram window_step_hist_, window_jitter_hist_;
 };
 
 }  // namespace vitreo::runtime

@@ -14,6 +14,7 @@
 #include "drivers/sim/simulated_peer.hpp"
 #include "rig/session/device_inputs.hpp"
 #include "rig/session/simulation_model.hpp"
+#include "rig/telemetry/telemetry_mapping.hpp"
 
 namespace vitreo::rig {
 
@@ -51,6 +52,8 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
     };
     d->driver->session().set_on_sample([this, raw, link_input](const drivers::Sample& s) {
       telemetry::RecordedInput in = encode_sample(s, raw->spec.device_id, raw->sequence++);
+      const drivers::SampleTime& t = std::visit([](const auto& x) -> const drivers::SampleTime& { return x.t; }, s);
+      raw->window.on_sample(t.received_us, t.received_us > t.host_us ? t.received_us - t.host_us : 0);
       in.channel = raw->spec.channel;
       // A stuck sensor (the driver's verdict: bit-identical for 50 ms of device time) is reported at
       // once, ahead of its sample: physics freezes the instrument as if the tracker were lost.
@@ -70,6 +73,7 @@ DeviceHub::DeviceHub(std::vector<DeviceSpec> specs, telemetry::TelemetrySource* 
       const bool down = to == drivers::LinkState::lost;
       if (!up && !down) return;
       raw->stuck_reported = false;  // a new link starts unstuck (the driver forgets too)
+      if (down) raw->window.reset();
       link_input(up ? telemetry::LinkEvent::Up : telemetry::LinkEvent::Lost);
     });
     devices_.push_back(std::move(d));
@@ -263,46 +267,25 @@ void DeviceHub::run_drivers() {
   }
 }
 
-namespace {
-// device_status_t's lifecycle codes (after ros2_control: inactive while connecting, active when
-// streaming, error when stale, lost when gone).
-std::int8_t status_code(drivers::LinkState s) {
-  switch (s) {
-    case drivers::LinkState::streaming: return 2;
-    case drivers::LinkState::stale: return 3;
-    case drivers::LinkState::lost: return 4;
-    default: return 1;
-  }
-}
-}  // namespace
-
-void DeviceHub::publish_status(std::uint64_t) {
-  if (!status_out_) return;
+void DeviceHub::publish_status(std::uint64_t now_us) {
   for (const auto& d : devices_) {
     const auto& session = d->driver->session();
-    const auto& st = session.stats();
-    telemetry::DeviceStatus s;
-    s.device_id = d->spec.device_id;
-    std::strncpy(s.name, d->spec.name.c_str(), sizeof s.name - 1);
-    std::strncpy(s.transport, d->driver->uri().c_str(), sizeof s.transport - 1);
-    s.state = status_code(session.state());
-    std::strncpy(s.detail, drivers::to_string(session.state()), sizeof s.detail - 1);
-    s.frames_rx = static_cast<std::int64_t>(st.frames);
-    s.bytes_rx = static_cast<std::int64_t>(st.bytes);
-    s.crc_errors = static_cast<std::int64_t>(st.crc_errors);
-    s.framing_errors = static_cast<std::int64_t>(st.framing_errors);
-    s.sequence_gaps = static_cast<std::int64_t>(st.drops);
-    s.reconnects = static_cast<std::int64_t>(st.reconnects);
-    s.stuck = session.stuck();
-    s.stuck_episodes = static_cast<std::int64_t>(st.stuck_episodes);
-    s.stuck_samples = static_cast<std::int64_t>(st.stuck_samples);
-    s.range_rejected = static_cast<std::int64_t>(st.range_rejected);
-    s.timestamp_jumps = static_cast<std::int64_t>(st.timestamp_jumps);
-    s.reader_stalls = static_cast<std::int64_t>(reader_stalls());
-    s.reader_stall_max_ms = static_cast<float>(reader_stall_max_us()) * 1e-3f;
-    if (session.stuck()) std::strncpy(s.detail, "stuck: identical samples for >= 50 ms", sizeof s.detail - 1);
-    status_out_->push(s);
+    // A device refused at this address (another kind, serial or protocol) is said once, not only
+    // shown in telemetry: it will never stream until it is replaced.
+    if (session.refusal() != d->refusal_reported) {
+      d->refusal_reported = session.refusal();
+      if (!d->refusal_reported.empty()) spdlog::error("device {} ({}): refused: {}", d->spec.name, d->driver->uri(), d->refusal_reported);
+    }
     d->last_state = session.state();
+    if (!status_out_) continue;
+    const SampleWindow::Measured w = d->window.measure(now_us);
+    telemetry::DeviceMeasured measured;
+    measured.sample_rate_hz = w.rate_hz;
+    measured.latency_p50_us = w.latency_p50_us;
+    measured.latency_p99_us = w.latency_p99_us;
+    measured.reader_stalls = reader_stalls();
+    measured.reader_stall_max_ms = static_cast<float>(reader_stall_max_us()) * 1e-3f;
+    status_out_->push(telemetry::device_status_item(d->spec.device_id, d->spec.name, d->driver->uri(), session, now_us, measured));
   }
 }
 

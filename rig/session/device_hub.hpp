@@ -32,6 +32,7 @@
 #include "rig/runtime/spsc_ring.hpp"
 #include "rig/runtime/triple_buffer.hpp"
 #include "rig/session/rig_file.hpp"
+#include "rig/session/sample_window.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "rig/telemetry/recording.hpp"
 
@@ -90,6 +91,9 @@ class DeviceHub {
   static constexpr std::uint64_t kStallWallUs = 200'000;
 
   std::size_t device_count() const { return devices_.size(); }
+  // The clock the devices' samples are stamped with (host monotonic µs; in lockstep the granted
+  // simulation time): what the rig stamps its own inputs with, so a recording's host times agree.
+  std::uint64_t now_us() { return clock_.now_us(); }
   // Before start(): called on the driver thread for each completed time-sync exchange of `device`
   // (vitreo-calibrate's clock calibration).
   void on_time_sync(std::size_t device, drivers::DeviceSession::TimeSyncFn f) {
@@ -126,6 +130,8 @@ class DeviceHub {
     drivers::LinkState last_state = drivers::LinkState::lost;  // as last published (driver thread)
     bool stuck_reported = false;                              // driver thread
     std::uint64_t bytes_unaccounted = 0;  // lockstep: bytes a stalled grant gave up on (driver thread)
+    SampleWindow window;                  // rate and latency of the last second (driver thread)
+    std::string refusal_reported;         // the refusal last logged (driver thread)
   };
   void run_sims();
   void run_drivers();

@@ -14,7 +14,8 @@
 //   id = 1                           # device id in telemetry and recordings (unique)
 //   serial = 1001                    # optional: the serial number it must announce (0: any)
 //   instrument = 0                   # trackers: the instrument it carries (0 the tool hand, 1 the light pipe)
-//   rate_hz = 1000                   # optional: the sample rate the host configures
+//   rate_hz = 1000                   # optional: the sample rate the host configures (default: the
+//                                    # protocol's rate for the device's type, PROTOCOL.md §7)
 //   script = "sim/tracker.sim"       # sim: URIs only, optional: the emulator's script, relative to
 //                                    # the rig file (default: the main job's scripted session)
 //
@@ -52,7 +53,7 @@ struct DeviceSpec {
   std::int32_t device_id = 0;
   int channel = 0;   // trackers: the instrument slot it carries
   std::uint32_t expected_serial = 0;  // 0: any
-  std::uint16_t sample_rate_hz = 0;   // 0: the driver's default
+  std::uint16_t sample_rate_hz = 0;   // 0: the protocol's rate for the type the device announces
   // sim: URIs: the emulator's script text (drivers/sim/emulator.hpp); empty: decided by the caller
   // (the main job's scripted session), else the built-in script of the device's kind.
   std::string sim_script;

@@ -21,9 +21,9 @@
 #include "rig/telemetry/commands.hpp"
 #include "rig/telemetry/publisher.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "rig/telemetry/telemetry_mapping.hpp"
 #include "rig/telemetry/terminal_commands.hpp"
 #include "rig/session/case_switcher.hpp"
-#include "rig/session/event_keys.hpp"
 #include "rig/session/frame_source.hpp"
 #include "rig/session/snapshot_writer.hpp"
 #include "vitreo/render/render_thread.hpp"
@@ -32,70 +32,56 @@ namespace vitreo::rig {
 
 namespace {
 
-telemetry::Event to_event(const core::TissueEvent& e, std::int64_t step, double t_s) {
-  telemetry::Event ev;
-  ev.step = step;
-  ev.t_s = t_s;
-  switch (e.kind) {
-    case core::TissueEventKind::kTear: ev.kind = telemetry::EventKind::Tear; break;
-    case core::TissueEventKind::kGripBroken: ev.kind = telemetry::EventKind::Contact; break;  // tissue slipped out of the jaws
-    default: ev.kind = telemetry::EventKind::AttachmentBroken; break;
-  }
-  ev.tissue_id = static_cast<std::int32_t>(e.surface);
-  for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
-  ev.magnitude = e.magnitude;
-  // Prefixed: the instruments pass a broken attachment on as their own event too (event_keys.hpp).
-  telemetry::copy_text(ev.what, e.kind == core::TissueEventKind::kTear           ? "tissue_tear"
-                                : e.kind == core::TissueEventKind::kGripBroken ? "tissue_grip_broken"
-                                                                                : "tissue_attachment_broken");
-  return ev;
+// A paused step's events: none (the lists keep the last step's until the world steps again).
+const std::vector<core::InstrumentEvent> kNoInstrumentEvents;
+const std::vector<core::TissueEvent> kNoTissueEvents;
+
+// The simulated instrument a hand (tracker) drives now: the working hand's selected tool, the other
+// hand's light pipe; -1 when the case has none for it.
+int driven_instrument(const SimulationModel& model, std::size_t tracker) {
+  const int sim = tracker == static_cast<std::size_t>(kToolTracker)         ? model.selected_tool()
+                  : tracker == static_cast<std::size_t>(kLightPipeTracker) ? model.current_case().light_pipe
+                                                                            : -1;
+  return sim >= 0 && static_cast<std::uint32_t>(sim) < model.simulation().instrument_count() ? sim : -1;
 }
 
-// What the hand holds: the working hand's selected tool, the other hand's light pipe (core names).
-const char* held_instrument(const SimulationModel& model, std::size_t tracker) {
-  if (tracker == static_cast<std::size_t>(kLightPipeTracker)) return core::to_string(core::InstrumentKind::kLightPipe);
-  const int tool = model.selected_tool();
-  const auto& tools = model.current_case().tools;
-  return tool >= 0 && static_cast<std::size_t>(tool) < tools.size() ? core::to_string(tools[static_cast<std::size_t>(tool)]) : "none";
+// The hand (tracker) a simulated instrument belongs to: the light pipe is the other hand's, every
+// tool the working hand's (only the one in the hand is inside the eye).
+int hand_of(const SimulationModel& model, std::uint32_t instrument) {
+  return static_cast<int>(instrument) == model.current_case().light_pipe ? kLightPipeTracker : kToolTracker;
 }
 
-telemetry::InstrumentState to_state(const InstrumentSlot& slot, const char* held, int id, std::int64_t step, double t_s) {
-  telemetry::InstrumentState st;
-  st.step = step;
-  st.t_s = t_s;
-  st.instrument_id = static_cast<std::int8_t>(id);
-  st.port_id = static_cast<std::int8_t>(slot.port);
-  std::snprintf(st.kind, sizeof st.kind, "%s", held);
-  for (int i = 0; i < 3; ++i) {
-    st.tip_mm[i] = slot.pose.tip_mm[i];
-    st.shaft_axis[i] = slot.pose.axis[i];
+// The step's telemetry from the model's state (rig/telemetry/telemetry_mapping.hpp says what each
+// field is): events as they happen, instrument states and controls at 250 Hz.
+// `stepped`: the world stepped (not paused), so its events are this step's.
+void push_step_telemetry(const SimulationModel& model, bool stepped, std::uint64_t k, std::int64_t step, double t_s,
+                         telemetry::TelemetrySource& out) {
+  telemetry::step_event_items(stepped ? model.world().events() : kNoTissueEvents,
+                              stepped ? model.simulation().events() : kNoInstrumentEvents, step, t_s,
+                              [&](std::uint32_t instrument) { return hand_of(model, instrument); },
+                              [&](const telemetry::Event& e) { out.push(e); });
+  if (k % 4 != 0) return;  // instrument states and controls at 250 Hz (CHANNELS.md)
+  const auto& slots = model.instruments();
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const int sim = driven_instrument(model, i);
+    if (!slots[i].present || sim < 0) continue;
+    const core::InstrumentState& st = model.simulation().instrument(static_cast<std::uint32_t>(sim));
+    const telemetry::Hand hand{static_cast<int>(i), model.current_case().tracker_port_ids[i], core::to_string(st.description.kind),
+                               slots[i].frozen};
+    out.push(telemetry::instrument_state_item(hand, st, step, t_s));
   }
-  st.roll_rad = slot.pose.roll_rad;
-  st.insertion_mm = slot.pose.insertion_mm;
-  st.actuation = slot.pose.actuation;
-  st.frozen = slot.frozen;
-  return st;
+  const SurgicalControls& c = model.controls();
+  out.push(telemetry::controls_item({c.vacuum_mmhg, c.cut_rate_cpm, c.reflux, c.laser_fire, c.pick_out, c.light_level, c.zoom,
+                                     model.laser().power_mw, model.laser().duration_ms},
+                                    step, t_s));
 }
 
-telemetry::Event instrument_event(const core::InstrumentEvent& e, std::int64_t step, double t_s) {
-  telemetry::Event ev;
-  ev.step = step;
-  ev.t_s = t_s;
-  switch (e.kind) {
-    case core::InstrumentEventKind::kLaserBurn: ev.kind = telemetry::EventKind::Burn; break;
-    case core::InstrumentEventKind::kUnintendedTear: ev.kind = telemetry::EventKind::Tear; break;
-    case core::InstrumentEventKind::kAttachmentBroken: ev.kind = telemetry::EventKind::AttachmentBroken; break;
-    default: ev.kind = telemetry::EventKind::Contact; break;  // forces, collisions, grasps, light dose
-  }
-  ev.instrument_id = e.instrument == core::kNone ? std::int8_t{-1} : static_cast<std::int8_t>(e.instrument);
-  // A grasp's, a lost grasp's and a broken attachment's `other` is the tissue surface.
-  const bool on_tissue = e.kind == core::InstrumentEventKind::kGrasp || e.kind == core::InstrumentEventKind::kGraspLost ||
-                         e.kind == core::InstrumentEventKind::kAttachmentBroken;
-  if (on_tissue && e.other != core::kNone) ev.tissue_id = static_cast<std::int32_t>(e.other);
-  for (int i = 0; i < 3; ++i) ev.position_mm[i] = e.position_mm[i];
-  ev.magnitude = e.magnitude;
-  telemetry::copy_text(ev.what, event_key(e.kind));
-  return ev;
+// The current case's score card, criteria and totals (score() scans the world: call at a low rate).
+void push_scores(SimulationModel& model, std::int64_t step, bool final_score, telemetry::TelemetrySource& out) {
+  const std::string_view case_id = model.scene().description.name;
+  out.push(telemetry::score_item(model.metrics().score(), case_id, step, final_score));
+  out.push(telemetry::criteria_item(model.metrics().criteria(), case_id, step, final_score));  // what score() just measured
+  out.push(telemetry::totals_item(model.metrics(), case_id, step, final_score));
 }
 
 // Recorded at the last step so a replay knows how long the session ran.
@@ -126,79 +112,6 @@ telemetry::RecordedInput command_input(const telemetry::AcceptedCommand& cmd) {
   if (cmd.code == telemetry::CommandCode::Pan) c.pan_y_mm = std::strtod(cmd.arg, nullptr);  // y travels as text (validated by the server)
   in.what = c;
   return in;
-}
-
-// The current case's score card as a telemetry item (score() scans the world: call at a low rate).
-telemetry::Score score_item(SimulationModel& model, std::int64_t step, bool final_score) {
-  const core::ScoreCard& card = model.metrics().score();
-  telemetry::Score s;
-  s.step = step;
-  telemetry::copy_text(s.case_id, model.scene().description.name);
-  s.final_score = final_score;
-  s.total = card.total;
-  for (const core::ScoreEntry& e : card.categories) {
-    if (s.n == telemetry::Score::kMaxMetrics) break;
-    telemetry::copy_text(s.name[s.n], e.name);
-    s.value[s.n++] = e.value;
-  }
-  return s;
-}
-
-// The criteria the last score() measured, and the totals behind the score card (the debrief's inputs).
-telemetry::Criteria criteria_item(SimulationModel& model, std::int64_t step, bool final_score) {
-  telemetry::Criteria c;
-  c.step = step;
-  telemetry::copy_text(c.case_id, model.scene().description.name);
-  c.final_score = final_score;
-  for (const core::CriterionProgress& p : model.metrics().criteria()) {
-    if (c.n == telemetry::Criteria::kMax) break;
-    telemetry::copy_text(c.kind[c.n], core::to_string(p.kind));
-    telemetry::copy_text(c.target[c.n], p.target);
-    c.value[c.n] = p.value;
-    c.threshold[c.n] = p.threshold;
-    c.progress[c.n] = p.progress;
-    c.met[c.n++] = p.met;
-  }
-  return c;
-}
-
-telemetry::Totals totals_item(SimulationModel& model, std::int64_t step, bool final_score) {
-  const core::SessionMetrics& m = model.metrics();
-  const core::SessionTotals& t = m.totals();
-  telemetry::Totals o;
-  o.step = step;
-  telemetry::copy_text(o.case_id, model.scene().description.name);
-  o.final_score = final_score;
-  o.formula_version = core::kScoreFormulaVersion;
-  o.elapsed_s = t.elapsed_s;
-  o.path_length_mm = t.path_length_mm;
-  o.retina_contacts = static_cast<std::int32_t>(t.retina_contacts);
-  o.retina_contact_time_s = t.retina_contact_time_s;
-  o.peak_retina_force_un = t.peak_retina_force_un;
-  o.retina_force_impulse_un_s = t.retina_force_impulse_un_s;
-  o.time_over_force_limit_s = t.time_over_force_limit_s;
-  o.force_limit_un = t.force_limit_un;
-  o.burns_on_target = static_cast<std::int32_t>(t.burns_on_target);
-  o.burns_elsewhere = static_cast<std::int32_t>(t.burns_elsewhere);
-  o.retina_tears = static_cast<std::int32_t>(t.retina_tears);
-  o.other_tears = static_cast<std::int32_t>(t.other_tears);
-  o.iatrogenic_events = static_cast<std::int32_t>(t.iatrogenic_events());
-  o.illumination_measured = t.illumination_measured;
-  o.working_time_s = t.working_time_s;
-  o.lit_working_time_s = t.lit_working_time_s;
-  for (std::size_t k = 0; k < core::kInstrumentEventKinds && o.n_kinds < telemetry::Totals::kMaxKinds; ++k) {
-    telemetry::copy_text(o.event_kind[o.n_kinds], event_key(static_cast<core::InstrumentEventKind>(k)));
-    o.event_count[o.n_kinds++] = static_cast<std::int32_t>(t.events[k]);
-  }
-  for (std::uint32_t i = 0; i < m.instrument_count() && o.n_instruments < telemetry::Totals::kMaxInstruments; ++i) {
-    const core::InstrumentMetrics& im = m.instrument(i);
-    telemetry::copy_text(o.instrument_kind[o.n_instruments], core::to_string(im.kind));
-    o.instrument_path_mm[o.n_instruments] = im.path_length_mm;
-    o.instrument_contacts[o.n_instruments] = static_cast<std::int32_t>(im.retina_contacts);
-    o.instrument_peak_force_un[o.n_instruments] = im.peak_retina_force_un;
-    o.instrument_contact_time_s[o.n_instruments++] = im.retina_contact_time_s;
-  }
-  return o;
 }
 
 // The final score and the case's criteria, for the summaries (live and replay print the same lines).
@@ -317,6 +230,7 @@ SessionSummary run_session(const SessionConfig& config) {
   harness_config.max_steps = config.steps;
   harness_config.physics_realtime = config.realtime;
   runtime::FixedStepLoop* loop = nullptr;        // the harness's loop; set before start()
+  std::optional<telemetry::TimingReporter> timing;  // physics timing on the harness's loop; set before start()
   std::unique_ptr<PreparedCase> retiring;        // a replaced case waiting for room in the ring
   // Case switches for the summary: fixed slots written by physics, read after it stopped.
   constexpr std::size_t kMaxSwitchLog = 64;
@@ -340,6 +254,9 @@ SessionSummary run_session(const SessionConfig& config) {
     auto consume = [&](const telemetry::RecordedInput& in) {
       telemetry::RecordedInput stamped = in;
       stamped.step = step;
+      // What no device sent (a command, a case switch, the end) is stamped when physics takes it, on
+      // the clock the devices' samples are stamped with (RECORDING.md).
+      if (stamped.host_time_us == 0) stamped.host_time_us = static_cast<std::int64_t>(hub.now_us());
       if (recorder) recorder->push(stamped);
       model.apply(stamped);
     };
@@ -379,22 +296,17 @@ SessionSummary run_session(const SessionConfig& config) {
     hub.lockstep_deliver(k, period_us);  // lockstep: step k's inputs, all of them, before taking them
     hub.take_new(consume);
     if (last) consume(session_end_marker(k + 1));
+    const bool stepped = !model.paused();  // paused: the world does not step, and has no new events
     const core::StepReport report = model.step();
     // The end of the case: announced once (console and telemetry), with the score that now stands.
     if (model.metrics().finished() && case_over_step.load(std::memory_order_relaxed) < 0) {
       case_over_complete.store(model.metrics().completed(), std::memory_order_relaxed);
       case_over_step.store(step, std::memory_order_release);
-      physics_out.push(score_item(model, step, true));
-      physics_out.push(criteria_item(model, step, true));
-      physics_out.push(totals_item(model, step, true));
+      push_scores(model, step, true, physics_out);
     }
     // The model's metrics observed the step; running scores go out at a low rate (score() scans
     // the world), the final one with the last step.
-    if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0)) {
-      physics_out.push(score_item(model, step, last));
-      physics_out.push(criteria_item(model, step, last));  // what score() just measured
-      physics_out.push(totals_item(model, step, last));
-    }
+    if (last || (config.score_every_steps > 0 && (k + 1) % config.score_every_steps == 0)) push_scores(model, step, last, physics_out);
     for (const auto& slot : model.instruments()) {
       if (slot.frozen) {
         ++summary.frozen_steps;
@@ -404,57 +316,23 @@ SessionSummary run_session(const SessionConfig& config) {
     summary.tears += report.tears;
     summary.attachments_broken += report.attachments_broken;
     if (!report.ok) ++summary.rolled_back;
-    for (const auto& e : model.world().events()) {
-      if (e.kind != core::TissueEventKind::kRolledBack) physics_out.push(to_event(e, step, t_s));
-    }
-    for (const auto& e : model.simulation().events()) {
-      physics_out.push(instrument_event(e, step, t_s));
+    for (const auto& e : stepped ? model.simulation().events() : kNoInstrumentEvents) {
       ++summary.instrument_events;
       if (e.kind == core::InstrumentEventKind::kGrasp) ++summary.grasps;
       if (e.kind == core::InstrumentEventKind::kLaserBurn) ++summary.burns;
     }
-    if (k % 4 == 0) {  // instrument state at 250 Hz (CHANNELS.md)
-      const auto& slots = model.instruments();
-      for (std::size_t i = 0; i < slots.size(); ++i) {
-        if (!slots[i].present) continue;
-        telemetry::InstrumentState st = to_state(slots[i], held_instrument(model, i), static_cast<int>(i), step, t_s);
-        // The simulated instrument this tracker drives now: the tool in the hand or the light pipe.
-        const int sim = i == static_cast<std::size_t>(kToolTracker)         ? model.selected_tool()
-                        : i == static_cast<std::size_t>(kLightPipeTracker) ? model.current_case().light_pipe
-                                                                            : -1;
-        if (sim >= 0 && static_cast<std::uint32_t>(sim) < model.simulation().instrument_count())
-          st.retina_force_un = model.simulation().instrument(static_cast<std::uint32_t>(sim)).retina_force_un;
-        physics_out.push(st);
-      }
-      const SurgicalControls& c = model.controls();
-      telemetry::Controls ctl;
-      ctl.step = step;
-      ctl.t_s = t_s;
-      ctl.vacuum_mmhg = c.vacuum_mmhg;
-      ctl.cut_rate_cpm = c.cut_rate_cpm;
-      ctl.reflux = c.reflux;
-      ctl.laser_fire = c.laser_fire;
-      ctl.pick_out = c.pick_out;
-      ctl.light_level = c.light_level;
-      ctl.zoom = c.zoom;
-      ctl.laser_power_mw = model.laser().power_mw;
-      ctl.laser_duration_ms = model.laser().duration_ms;
-      physics_out.push(ctl);
-    }
+    push_step_telemetry(model, stepped, k, step, t_s, physics_out);
     if (renderer && (k % view_every == 0 || last)) {
       if (capture_view(model, k, t_s, views.write_slot())) views.publish();
     }
-    if (loop && (k + 1) % 250 == 0) {  // physics timing at 4 Hz, cumulative over the session
-      telemetry::PhysicsTiming t = telemetry::timing_item(loop->stats(), k, harness_config.loop.period_ns);
-      t.paused = model.paused();
-      physics_out.push(t);
-    }
+    if (timing) timing->on_step(k, model.paused());  // 10 Hz, each message its own window (CHANNELS.md)
     if (last && stop != 0) {
       stopped_by = stop;
       loop->request_stop();
     }
   });
   loop = &harness.loop();
+  timing.emplace(harness.loop(), physics_out, telemetry::TimingReporter::steps_for_rate(harness_config.loop.period_ns, 10.0));
   std::int64_t next_receive_status_ns = 0;
   harness.add_service("telemetry", std::chrono::milliseconds(2), [&] {
     if (const std::int64_t over = case_over_step.load(std::memory_order_acquire); over >= 0 && over != case_over_announced) {
@@ -592,6 +470,7 @@ SessionSummary run_session(const SessionConfig& config) {
     add(st.framing_errors, "framing errors");
     add(st.drops, "frames missing (sequence gaps)");
     add(st.version_errors + st.unknown_type + st.length_errors, "frames of another version, type or length");
+    add(st.identity_rejected + st.protocol_rejected, "announcements refused (another device, serial or protocol)");
     if (!faults.empty()) summary.fault_lines.push_back(hub.name(i) + ": " + faults);
   }
   if (hub.reader_stalls() > 0) {

@@ -52,7 +52,7 @@ struct Event {
   std::int32_t tissue_id = -1;
   double position_mm[3] = {};
   double magnitude = 0;  // unit per kind: see event_t.lcm
-  char what[24] = {};    // the simulation's name of the event
+  char what[32] = {};    // the simulation's name of the event (the longest key is 24 characters)
 };
 
 struct PhysicsTiming {
@@ -68,12 +68,14 @@ struct PhysicsTiming {
 struct DeviceStatus {
   std::int32_t device_id = 0;
   char name[24] = {};
-  char transport[40] = {};
+  char transport[96] = {};
   std::int8_t state = 0;  // device_status_t::STATE_*
-  char detail[64] = {};
+  char detail[96] = {};
   std::int64_t frames_rx = 0, frames_tx = 0, bytes_rx = 0, crc_errors = 0, framing_errors = 0;
-  std::int64_t sequence_gaps = 0, heartbeat_misses = 0, reconnects = 0, last_sample_age_us = 0;
+  std::int64_t version_rejected = 0, unknown_type_rejected = 0, length_rejected = 0, identity_rejected = 0, protocol_rejected = 0;
+  std::int64_t sequence_gaps = 0, heartbeat_misses = 0, reconnects = 0, last_sample_age_us = -1;
   float sample_rate_hz = 0, latency_p50_us = 0, latency_p99_us = 0, clock_offset_us = 0;
+  std::int32_t configured_rate_hz = 0;
   bool stuck = false;
   std::int64_t stuck_episodes = 0, stuck_samples = 0, range_rejected = 0, timestamp_jumps = 0, reader_stalls = 0;
   float reader_stall_max_ms = 0;
@@ -119,7 +121,7 @@ struct Totals {
   bool illumination_measured = false;
   double working_time_s = 0, lit_working_time_s = 0;
   std::uint8_t n_kinds = 0;
-  char event_kind[kMaxKinds][24] = {};
+  char event_kind[kMaxKinds][32] = {};  // event_key(): the longest is 24 characters
   std::int32_t event_count[kMaxKinds] = {};
   std::uint8_t n_instruments = 0;
   char instrument_kind[kMaxInstruments][16] = {};

@@ -23,6 +23,7 @@
 #include "rig/telemetry/channels.hpp"
 #include "rig/telemetry/items.hpp"
 #include "rig/telemetry/lcm_subscribe.hpp"
+#include "rig/telemetry/wall_time.hpp"
 
 namespace vitreo::telemetry {
 
@@ -80,27 +81,17 @@ class TelemetryPublisher {
   std::uint64_t publish_errors_ = 0;
 };
 
-// Wall clock in µs since the epoch: LCM's utime convention.
-std::int64_t wall_time_us() noexcept;
-
-// The loop's statistics as a telemetry item. window_steps = steps in the histograms (since the
-// loop's last reset_histograms(), which the caller may do after each publish); the caller sets paused.
-PhysicsTiming timing_item(const runtime::LoopStats& s, std::uint64_t step, std::int64_t period_ns);
-
 // Physics-side helper: call on_step() from inside the step callback; every `every_steps` steps it
-// pushes a PhysicsTiming for the steps since its last report and starts a new histogram window.
-// Cost: one quantile scan of the histograms per report (a few µs at 10 Hz), no allocation.
+// pushes a PhysicsTiming for the steps since its last report (the loop's window_stats()) and starts
+// a new window; the loop's stats() keep the whole session's. Cost: one quantile scan of the window's
+// histograms per report (a few µs at 10 Hz), no allocation.
 class TimingReporter {
  public:
   TimingReporter(runtime::FixedStepLoop& loop, TelemetrySource& out, std::uint32_t every_steps = 100)
       : loop_(loop), out_(out), every_(every_steps ? every_steps : 1) {}
-  void on_step(std::uint64_t step, bool paused) {
-    if ((step + 1) % every_ != 0) return;
-    PhysicsTiming t = timing_item(loop_.stats(), step, loop_.config().period_ns);
-    t.paused = paused;
-    out_.push(t);
-    loop_.reset_histograms();
-  }
+  // The number of steps between reports that gives `hz` at the loop's period (at least 1).
+  static std::uint32_t steps_for_rate(std::int64_t period_ns, double hz);
+  void on_step(std::uint64_t step, bool paused);
 
  private:
   runtime::FixedStepLoop& loop_;

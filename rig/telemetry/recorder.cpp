@@ -1,7 +1,7 @@
 // The recorder: header, inputs, a checksum event at every flush, the end event (RECORDING.md).
-#include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -22,12 +22,6 @@
 namespace vitreo::telemetry {
 namespace {
 
-std::int64_t monotonic_us() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000 + ts.tv_nsec / 1000;
-}
-
 template <class Msg>
 void encode(const Msg& m, std::vector<std::uint8_t>& buf) {
   buf.resize(static_cast<std::size_t>(m.getEncodedSize()));
@@ -46,12 +40,13 @@ Recorder::Recorder(const std::string& path, RecordingHeader header, RecorderConf
     : path_(path), config_(config), ring_(config.ring_capacity) {
   log_ = std::make_unique<lcm::LogFile>(path, "w");
   if (!log_->good()) throw std::runtime_error("recorder: cannot create '" + path + "': " + std::strerror(errno));
-  wall_minus_mono_us_ = wall_time_us() - monotonic_us();
   header.utime_us = wall_time_us();
+  start_wall_us_ = last_log_us_ = header.utime_us;
+  period_us_ = header.step_period_us > 0 ? header.step_period_us : 1000;
   vitreo_lcm::recording_header_t h;
   h.utime_us = header.utime_us;
   h.format_version = vitreo_lcm::recording_header_t::FORMAT_VERSION;
-  h.software_version = header.software_version;
+  h.software_version = header.software_version.empty() ? std::string("vitreo ") + VITREO_VERSION : header.software_version;
   h.case_id = header.case_id;
   h.step_period_us = header.step_period_us;
   h.config_name = header.config_name;
@@ -65,6 +60,11 @@ Recorder::Recorder(const std::string& path, RecordingHeader header, RecorderConf
 }
 
 Recorder::~Recorder() { close(); }
+
+std::int64_t Recorder::log_time_of_step(std::int64_t step) noexcept {
+  last_log_us_ = std::max(last_log_us_, start_wall_us_ + step * period_us_);
+  return last_log_us_;
+}
 
 void Recorder::write_event(const char* channel, std::int64_t timestamp_us) {
   lcm::LogEvent ev{};
@@ -80,7 +80,7 @@ void Recorder::write_event(const char* channel, std::int64_t timestamp_us) {
 
 void Recorder::write_input(const RecordedInput& in) {
   encode(to_lcm(in), buf_);
-  write_event(kChanRecInput, in.host_time_us + wall_minus_mono_us_);
+  write_event(kChanRecInput, log_time_of_step(in.step));
   ++inputs_in_file_;
   last_step_ = in.step;
   ++written_;
@@ -95,7 +95,7 @@ void Recorder::write_check() {
   c.last_step = last_step_;
   c.crc32 = crc_;
   encode(c, buf_);
-  write_event(kChanRecCheck, wall_time_us());
+  write_event(kChanRecCheck, last_log_us_);
   events_at_check_ = event_num_;
   ++checks_;
 }
@@ -159,7 +159,7 @@ bool Recorder::finish(const RecordingEnd& end) noexcept {
     e.stop_reason = end.stop_reason;
     e.crc32 = crc_;
     encode(e, buf_);
-    write_event(kChanRecEnd, e.utime_us);
+    write_event(kChanRecEnd, log_time_of_step(end.steps));
     flush();
     fdatasync(fileno(log_->getFilePtr()));
     log_.reset();

@@ -110,7 +110,12 @@ class Recorder {
   std::unique_ptr<lcm::LogFile> log_;
   runtime::SpscRing<RecordedInput> ring_;
   std::vector<std::uint8_t> buf_;
-  std::int64_t wall_minus_mono_us_ = 0;  // maps monotonic sample times to log (wall) timestamps
+  // Log timestamps (what lcm-logplayer paces by): the recording's start on the wall clock plus the
+  // simulation time of the step an input was consumed at, never decreasing (RECORDING.md).
+  std::int64_t start_wall_us_ = 0;
+  std::int64_t period_us_ = 1000;
+  std::int64_t last_log_us_ = 0;
+  std::int64_t log_time_of_step(std::int64_t step) noexcept;
   std::int64_t event_num_ = 0;
   std::int64_t last_flush_ns_ = INT64_MIN;
   std::uint32_t crc_ = 0;             // running CRC-32 of every event written (RECORDING.md)

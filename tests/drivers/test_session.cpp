@@ -115,12 +115,40 @@ TEST(Session, APoseIdenticalFor50MsOfDeviceTimeIsStuckAndMovingAgainEndsIt) {
   EXPECT_EQ(h.s.stats().stuck_episodes, 1u);
 }
 
+// A device configured below 1 kHz is stale after 20 of its periods, not 20 ms: an eyeball
+// fixture at 250 Hz sends a sample every 4 ms, so 20 ms would be only five of them.
+TEST(Session, StaleAfterTwentyPeriodsOfTheConfiguredRate) {
+  Harness h;
+  h.s.transport_up(0);
+  vp_message m = make(VP_MSG_DEVICE_INFO, h.seq++);
+  m.u.device_info.device_type = VP_DEVICE_EYEBALL;
+  m.u.device_info.proto_major = VP_PROTO_MAJOR;
+  h.s.on_frame(VP_OK, m, 10);
+  EXPECT_EQ(h.s.configured_rate_hz(), 250);
+  EXPECT_EQ(h.s.stale_after_us(), 80'000u);
+  h.ack(20);
+  vp_message e = make(VP_MSG_EYEBALL_STATE, h.seq++);
+  e.u.eyeball.timestamp_us = 5'000'000;
+  e.u.eyeball.q_wxyz[0] = 1;
+  h.s.on_frame(VP_OK, e, 1000);
+  ASSERT_EQ(h.s.state(), LinkState::streaming);
+  h.s.tick(1000 + 79'000);
+  EXPECT_EQ(h.s.state(), LinkState::streaming) << "79 ms: fewer than 20 periods";
+  h.s.tick(1000 + 81'000);
+  EXPECT_EQ(h.s.state(), LinkState::stale);
+}
+
 TEST(Session, RefusesDeviceWithOtherProtocolMajor) {
   Harness h;
   h.s.transport_up(0);
   h.info(1000, 2);
   EXPECT_EQ(h.s.state(), LinkState::connecting);
-  EXPECT_EQ(h.s.stats().version_errors, 1u);
+  // A valid frame refused for what it says, not a frame of another version: counted apart, and
+  // the refusal names both versions (device_status_t shows it as ERROR with this detail).
+  EXPECT_EQ(h.s.stats().protocol_rejected, 1u);
+  EXPECT_EQ(h.s.stats().version_errors, 0u);
+  EXPECT_NE(h.s.refusal().find("protocol 2."), std::string::npos) << h.s.refusal();
+  EXPECT_NE(h.s.refusal().find("this host 1."), std::string::npos) << h.s.refusal();
   EXPECT_FALSE(h.s.has_device_info());
 }
 

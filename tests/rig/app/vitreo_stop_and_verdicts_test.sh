@@ -61,7 +61,11 @@ whole="$tmp/term/session.lcmlog"
 size=$(stat -c %s "$whole")
 head -c $((size * 2 / 3)) "$whole" >"$tmp/cut.lcmlog"
 cp "$whole" "$tmp/flipped.lcmlog"
-printf '\x42' | dd of="$tmp/flipped.lcmlog" bs=1 seek=$((size / 2)) conv=notrunc 2>/dev/null
+# One byte inverted inside the data of the input event nearest the middle: not in the LCM framing's
+# timestamp, which the checksum does not cover (RECORDING.md), and never left unchanged.
+at=$(grep -obUa VITREO_REC_INPUT "$whole" | cut -d: -f1 | awk -v m=$((size / 2)) '$1 >= m { print $1 + 16 + 20; exit }')
+byte=$(od -An -tu1 -j "$at" -N1 "$whole" | tr -d ' ')
+printf "\\$(printf '%03o' $((byte ^ 255)))" | dd of="$tmp/flipped.lcmlog" bs=1 seek="$at" conv=notrunc 2>/dev/null
 { cat "$whole"; head -c 500 /dev/urandom; } >"$tmp/appended.lcmlog"
 cat "$whole" "$whole" >"$tmp/twice.lcmlog"
 verdict() {  # verdict <file> <exit> <pattern>

@@ -28,6 +28,7 @@
 #include "rig/runtime/triple_buffer.hpp"
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "rig/telemetry/publisher.hpp"
+#include "rig/telemetry/telemetry_mapping.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 
 using namespace vitreo;
@@ -113,9 +114,11 @@ RunResult run_loop(Workload& work, std::uint64_t steps, bool loaded) {
       st.tip_mm[2] = 11.0 - t_s;
       src.push(st);
     }
-    // 10 Hz physics_timing_t. Not TimingReporter: its window resets would leave this benchmark
-    // only the last window's histogram to report.
-    if (k % 100 == 99) src.push(telemetry::timing_item(hp->loop().stats(), k, cfg.loop.period_ns));
+    // 10 Hz physics_timing_t over its window; the loop's stats() keep the whole run for the report.
+    if (k % 100 == 99) {
+      src.push(telemetry::timing_item(hp->loop().window_stats(), k, cfg.loop.period_ns, false));
+      hp->loop().start_window();
+    }
   });
   hp = &h;
   std::uint64_t frames = 0;

@@ -363,6 +363,11 @@ TEST(TimingReporter, PublishesWindowedLoopTimingEveryNSteps) {
   EXPECT_GT(timing.got[2].late_steps, 0);
   EXPECT_TRUE(timing.got[2].paused);
   EXPECT_EQ(timing.got[2].period_us, 1000);
+  // The windows do not take the session's own statistics with them: the summary still sees all 30.
+  EXPECT_EQ(loop.stats().window_steps, 30u);
+  EXPECT_EQ(loop.stats().step_max_ns, 1'500'000);
+  EXPECT_EQ(TimingReporter::steps_for_rate(1'000'000, 10.0), 100u);  // 10 Hz at 1 kHz
+  EXPECT_EQ(TimingReporter::steps_for_rate(4'000'000, 10.0), 25u);
 }
 
 TEST(TelemetryPublisher, DefaultUrlNeverLeavesThisMachine) {

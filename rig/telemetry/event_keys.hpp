@@ -4,7 +4,7 @@
 // is prose for people ("light pipe too close to the macula"); these are keys a program can match.
 #include "core/instruments/instrument_events.hpp"
 
-namespace vitreo::rig {
+namespace vitreo::telemetry {
 
 constexpr const char* event_key(core::InstrumentEventKind k) {
   using K = core::InstrumentEventKind;
@@ -26,4 +26,4 @@ constexpr const char* event_key(core::InstrumentEventKind k) {
   return "unknown";
 }
 
-}  // namespace vitreo::rig
+}  // namespace vitreo::telemetry
