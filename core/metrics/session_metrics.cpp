@@ -13,6 +13,7 @@ void MetricsOptions::validate() const {
   require_range(retina_force_limit_un, -1e12, 1e12, "metrics: retina_force_limit_un");
   require_range(laser_target_band_mm, 0.0, 10.0, "metrics: laser_target_band_mm");
   require_range(odometer_stride_mm, 0.0, 1.0, "metrics: odometer_stride_mm");
+  require_range(extreme_zoom, 1.0, 1e3, "metrics: extreme_zoom");
   require_range(static_cast<double>(completion_check_steps), 1.0, 1e6, "metrics: completion_check_steps");
   progress.validate();
   scores.validate();
@@ -48,7 +49,13 @@ SessionMetrics::SessionMetrics(const TissueWorld& world, MetricsCase c, const Si
   }
   if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = InstrumentSceneOptions{}.retina_force_limit_un;
   last_world_step_ = world_.step_count();
-  card_.categories.reserve(4);
+  card_.categories.reserve(5);
+}
+
+void SessionMetrics::watch_microscope(const Microscope* microscope, const EyeModel* eye) {
+  microscope_ = microscope && eye ? microscope : nullptr;
+  eye_ = microscope_ ? eye : nullptr;
+  totals_.microscope_measured = microscope_ != nullptr;
 }
 
 Status SessionMetrics::observe(double dt) {
@@ -93,6 +100,10 @@ void SessionMetrics::accumulate(double dt) {
   const double limit = totals_.force_limit_un;
   const LightExposure& light = sim_->light();
   const double cos_cone = std::cos(light.half_angle_rad);
+  // The microscope's view, worked out once this step, when a working tip is there to be judged.
+  MicroscopeView view;
+  bool have_view = false;
+  glance_ = MicroscopeGlance{};
   for (std::uint32_t i = 0; i < per_instrument_.size(); ++i) {
     const InstrumentState& st = sim_->instrument(i);
     InstrumentMetrics& m = per_instrument_[i];
@@ -141,6 +152,26 @@ void SessionMetrics::accumulate(double dt) {
         const double d = to.norm();
         if (d > 0.0 && to.dot(light.axis) >= cos_cone * d) totals_.lit_working_time_s += dt;
       }
+    }
+
+    // Microscope handling: a working tip inside the eye is the work the field should hold —
+    // in the field, near its centre, within the depth of field, at a usable zoom.
+    if (microscope_ && st.inside && st.description.kind != InstrumentKind::kLightPipe) {
+      if (!have_view) {
+        view = microscope_->view(*eye_);
+        have_view = true;
+        glance_.judged = true;
+        glance_.depth_of_field_mm = view.depth_of_field_mm;
+      }
+      const double r = view.field_radius(st.frame.tip);
+      glance_.field_radius = std::max(glance_.field_radius, r);
+      glance_.defocus_mm = std::max(glance_.defocus_mm, std::abs(view.defocus_mm(st.frame.tip)));
+      totals_.microscope_working_time_s += dt;
+      if (!(r <= 1.0)) totals_.out_of_field_s += dt;
+      const double rc = std::min(r, 1.0);
+      totals_.off_centre_s += rc * rc * dt;
+      if (!view.in_focus(st.frame.tip)) totals_.out_of_focus_s += dt;
+      if (microscope_->zoom() > options_.extreme_zoom) totals_.extreme_zoom_s += dt;
     }
   }
 

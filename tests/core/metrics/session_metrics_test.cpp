@@ -307,10 +307,53 @@ TEST(SessionMetrics, PressingLongerLowersTissueTreatmentAndLongerPathsLowerEffic
       EXPECT_GE(e.value, 0.0);
       EXPECT_LE(e.value, 100.0);
     }
-    // No criteria: nothing to achieve, so no target_achievement; never a microscope score.
+    // No criteria: nothing to achieve, so no target_achievement; no microscope watched, no microscope score.
     EXPECT_EQ(c->find("target_achievement"), nullptr);
     EXPECT_EQ(c->find("microscope_handling"), nullptr);
   }
+}
+
+// Microscope handling on a scripted tip: the view centred on the posterior pole of a (small) eye
+// model looks down −z from just behind its lens, so where a tip lies in the field and in the depth
+// of field follows from its position by hand (tan 20° field half-angle at zoom 1; Berek's depth of
+// field 5.13 mm, microscope_test.cpp). Three phases: 100 steps at the field centre 1 mm above the
+// retina, 200 steps at 1.5 field radii and 7 mm above it (out of field and out of focus), 100 steps
+// at half a field radius 1 mm above it; then 50 steps outside the eye, which are not judged.
+TEST(SessionMetrics, MicroscopeHandlingTimesTheTipOutOfTheFieldAndOutOfFocus) {
+  EyeParameters p;
+  p.retina_vertices = 500;
+  p.gel_shells = 0;
+  const EyeModel eye = build_eye_model(p);
+  const Microscope scope(MicroscopeSettings{}, Vec2::Zero());
+  const double eye_z = eye.lens_center_z_mm - 0.5 * p.lens_thickness_mm - 0.5;
+  const double retina_z = -eye.wall.radius_toward(-Vec3::UnitZ()) + p.retina_thickness_mm;
+  const double half_tan = std::tan(20.0 * kPi / 180.0);
+
+  Bench b(InstrumentKind::kPick, -11.5);  // the bench's sheet lies below the eye model's retina
+  SessionMetrics m(b.world, b.metrics_case(), b.instruments.get());
+  m.watch_microscope(&scope, &eye);
+  const double near_z = retina_z + 1.0, far_z = retina_z + 7.0;
+  for (int k = 0; k < 100; ++k) step_and_observe(b, m, Vec3(0.0, 0.0, near_z));
+  EXPECT_TRUE(m.microscope_glance().judged);
+  EXPECT_NEAR(m.microscope_glance().field_radius, 0.0, 1e-9);
+  EXPECT_NEAR(m.microscope_glance().defocus_mm, 1.0, 1e-9);
+  for (int k = 0; k < 200; ++k) step_and_observe(b, m, Vec3(1.5 * half_tan * (eye_z - far_z), 0.0, far_z));
+  EXPECT_NEAR(m.microscope_glance().field_radius, 1.5, 1e-9);
+  for (int k = 0; k < 100; ++k) step_and_observe(b, m, Vec3(0.0, -0.5 * half_tan * (eye_z - near_z), near_z));
+  for (int k = 0; k < 50; ++k) step_and_observe(b, m, Vec3(0.0, 0.0, 20.0), false);  // out of the eye: not judged
+  EXPECT_FALSE(m.microscope_glance().judged);
+
+  const SessionTotals& t = m.totals();
+  ASSERT_TRUE(t.microscope_measured);
+  EXPECT_NEAR(t.microscope_working_time_s, 0.4, 1e-9);
+  EXPECT_NEAR(t.out_of_field_s, 0.2, 1e-9);
+  EXPECT_NEAR(t.off_centre_s, 0.2 * 1.0 + 0.1 * 0.25, 1e-9);
+  EXPECT_NEAR(t.out_of_focus_s, 0.2, 1e-9);
+  EXPECT_EQ(t.extreme_zoom_s, 0.0);
+  // No criteria (P = 1): 100 · exp(−(2 · 0.5 + 0.5 · 0.5625 + 1 · 0.5)).
+  const ScoreEntry* e = m.score().find("microscope_handling");
+  ASSERT_NE(e, nullptr);
+  EXPECT_NEAR(e->value, 100.0 * std::exp(-(1.0 + 0.28125 + 0.5)), 1e-9);
 }
 
 }  // namespace
