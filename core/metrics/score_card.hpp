@@ -46,8 +46,10 @@ struct SessionTotals {
   double working_time_s = 0.0;               // instrument-seconds of non-light instruments inside
   double lit_working_time_s = 0.0;           // ... with the tip inside the light cone
   // Microscope handling, when the metrics watch the microscope: instrument-seconds of the working
-  // (non-light) instruments' tips inside the eye, and of those the time out of the field of view,
-  // ∫ min(r, 1)² dt (r: the tip's distance from the field's centre over the field's radius), the
+  // (non-light) instruments' tips at work inside the eye (MetricsOptions::work_clearance_mm), and
+  // of those the time out of the field of view,
+  // ∫ c² dt, c = (min(r, 1) − r₀) / (1 − r₀) beyond r₀ = MetricsOptions::centre_radius, else 0 (r: the
+  // tip's distance from the field's centre over the field's radius), the
   // time out of the depth of field and the time at an extreme zoom (MetricsOptions::extreme_zoom).
   bool microscope_measured = false;
   double microscope_working_time_s = 0.0;
@@ -97,7 +99,7 @@ struct ScoreOptions {
   double illumination_share = 0.5;
 
   // Microscope handling: e-folds for the whole working time spent out of the field, at the field's
-  // edge (∫ min(r, 1)² dt over the working time), out of focus and at an extreme zoom.
+  // edge (∫ c² dt over the working time, SessionTotals::off_centre_s), out of focus and at an extreme zoom.
   double per_out_of_field = 2.0;
   double per_off_centre = 0.5;
   double per_out_of_focus = 1.0;

@@ -14,6 +14,8 @@ void MetricsOptions::validate() const {
   require_range(laser_target_band_mm, 0.0, 10.0, "metrics: laser_target_band_mm");
   require_range(odometer_stride_mm, 0.0, 1.0, "metrics: odometer_stride_mm");
   require_range(extreme_zoom, 1.0, 1e3, "metrics: extreme_zoom");
+  require_range(work_clearance_mm, 0.0, 30.0, "metrics: work_clearance_mm");
+  require_range(centre_radius, 0.0, 0.99, "metrics: centre_radius");
   require_range(static_cast<double>(completion_check_steps), 1.0, 1e6, "metrics: completion_check_steps");
   progress.validate();
   scores.validate();
@@ -154,9 +156,9 @@ void SessionMetrics::accumulate(double dt) {
       }
     }
 
-    // Microscope handling: a working tip inside the eye is the work the field should hold —
-    // in the field, near its centre, within the depth of field, at a usable zoom.
-    if (microscope_ && st.inside && st.description.kind != InstrumentKind::kLightPipe) {
+    // Microscope handling: a working tip at work is what the field should hold — in the field,
+    // near its centre, within the depth of field, at a usable zoom.
+    if (microscope_ && st.inside && st.description.kind != InstrumentKind::kLightPipe && at_work(st)) {
       if (!have_view) {
         view = microscope_->view(*eye_);
         have_view = true;
@@ -168,8 +170,9 @@ void SessionMetrics::accumulate(double dt) {
       glance_.defocus_mm = std::max(glance_.defocus_mm, std::abs(view.defocus_mm(st.frame.tip)));
       totals_.microscope_working_time_s += dt;
       if (!(r <= 1.0)) totals_.out_of_field_s += dt;
-      const double rc = std::min(r, 1.0);
-      totals_.off_centre_s += rc * rc * dt;
+      // Off centre: 0 within the central part of the field, rising as the square to 1 at its edge.
+      const double c = std::max(0.0, std::min(r, 1.0) - options_.centre_radius) / (1.0 - options_.centre_radius);
+      totals_.off_centre_s += c * c * dt;
       if (!view.in_focus(st.frame.tip)) totals_.out_of_focus_s += dt;
       if (microscope_->zoom() > options_.extreme_zoom) totals_.extreme_zoom_s += dt;
     }
@@ -189,6 +192,20 @@ void SessionMetrics::accumulate(double dt) {
     }
   }
   return;
+}
+
+bool SessionMetrics::at_work(const InstrumentState& st) const {
+  using K = InstrumentKind;
+  const K k = st.description.kind;
+  // Holding tissue or touching the retina (not brushing through the gel on the way).
+  if (st.grip != kNone || st.retina_force_un > options_.contact_force_un) return true;
+  if ((k == K::kVitrector || k == K::kDrainageNeedle) && st.input.pedal > 0.0) return true;      // aspirating, cutting
+  if (k == K::kEndolaser && st.input.trigger) return true;                                      // firing
+  // Near the retina: close to the wall behind the ora serrata (the ports lie in front of it, so
+  // entering the eye is not work).
+  const Vec3 from_centre = st.frame.tip - eye_->wall.center();
+  const double polar = std::atan2(Vec2(from_centre.x(), from_centre.y()).norm(), -from_centre.z());
+  return polar < eye_->ora_polar_rad && eye_->wall.clearance(st.frame.tip) <= options_.work_clearance_mm;
 }
 
 const std::vector<CriterionProgress>& SessionMetrics::criteria() {

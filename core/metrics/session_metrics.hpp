@@ -42,6 +42,13 @@ struct MetricsOptions {
   // at zoom 1, the top of an ophthalmic microscope's range: a field of about 2.4 mm on the fundus
   // in the contact-lens view, which a working tip keeps leaving).
   double extreme_zoom = 6.0;
+  // A working tip is at work — and judged in the microscope's view — while it acts on tissue
+  // (holds it, touches the retina, aspirates, fires) or is within this of the retina (mm from the wall,
+  // behind the ora serrata): not while it travels from its port through the periphery to the work.
+  double work_clearance_mm = 2.0;
+  // The work is centred while within this share of the field's radius; beyond it, off centre
+  // counts up to 1 at the edge (see SessionTotals::off_centre_s).
+  double centre_radius = 0.5;
   ProgressOptions progress;
   ScoreOptions scores;
   void validate() const;  // throws InvalidArgument
@@ -110,6 +117,8 @@ class SessionMetrics final : public StepObserver {
 
  private:
   void accumulate(double dt);
+  // A working tip at work (MetricsOptions::work_clearance_mm); needs the watched eye.
+  bool at_work(const InstrumentState& st) const;
 
   const TissueWorld& world_;
   const Simulation* sim_;
