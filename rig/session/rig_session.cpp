@@ -186,6 +186,12 @@ telemetry::Totals totals_item(SimulationModel& model, std::int64_t step, bool fi
   o.illumination_measured = t.illumination_measured;
   o.working_time_s = t.working_time_s;
   o.lit_working_time_s = t.lit_working_time_s;
+  o.microscope_measured = t.microscope_measured;
+  o.microscope_working_time_s = t.microscope_working_time_s;
+  o.out_of_field_s = t.out_of_field_s;
+  o.off_centre_s = t.off_centre_s;
+  o.out_of_focus_s = t.out_of_focus_s;
+  o.extreme_zoom_s = t.extreme_zoom_s;
   for (std::size_t k = 0; k < core::kInstrumentEventKinds && o.n_kinds < telemetry::Totals::kMaxKinds; ++k) {
     telemetry::copy_text(o.event_kind[o.n_kinds], event_key(static_cast<core::InstrumentEventKind>(k)));
     o.event_count[o.n_kinds++] = static_cast<std::int32_t>(t.events[k]);

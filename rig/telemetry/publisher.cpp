@@ -237,6 +237,12 @@ void TelemetryPublisher::publish_item(const TelemetryItem& item) {
           m.illumination_measured = v.illumination_measured;
           m.working_time_s = v.working_time_s;
           m.lit_working_time_s = v.lit_working_time_s;
+          m.microscope_measured = v.microscope_measured;
+          m.microscope_working_time_s = v.microscope_working_time_s;
+          m.out_of_field_s = v.out_of_field_s;
+          m.off_centre_s = v.off_centre_s;
+          m.out_of_focus_s = v.out_of_focus_s;
+          m.extreme_zoom_s = v.extreme_zoom_s;
           const std::size_t nk = std::min<std::size_t>(v.n_kinds, Totals::kMaxKinds);
           m.n_kinds = static_cast<std::int16_t>(nk);
           for (std::size_t i = 0; i < nk; ++i) {
