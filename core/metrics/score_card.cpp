@@ -23,12 +23,13 @@ void ScoreOptions::validate() const {
                         per_second_over_limit, per_limit_second,  per_peak_squared,     per_excessive_force,
                         per_retina_tear,     per_lens_touch,      per_wall_contact,     per_light_toxicity,
                         per_light_too_close, per_burn_on_detached, per_burn_off_target, per_instrument_collision,
-                        per_retinal_contact, per_grasp_lost};
+                        per_retinal_contact, per_grasp_lost,      weight_microscope,    per_out_of_field,
+                        per_off_centre,      per_out_of_focus,    per_extreme_zoom};
   for (double v : all) require_range(v, 0.0, 1e6, "scores: weights and penalties");
   require_range(illumination_share, 0.0, 1.0, "scores: illumination_share");
   require_range(reference_time_s, 1e-3, 1e6, "scores: reference_time_s");
   require_range(reference_path_mm, 1e-3, 1e7, "scores: reference_path_mm");
-  if (!(weight_target + weight_efficiency + weight_tissue + weight_instrument > 0.0)) {
+  if (!(weight_target + weight_efficiency + weight_tissue + weight_instrument + weight_microscope > 0.0)) {
     throw InvalidArgument("scores: all category weights are zero");
   }
 }
@@ -103,6 +104,20 @@ void compute_scores(const SessionTotals& t, const std::vector<CriterionProgress>
     handling *= (1.0 - o.illumination_share) + o.illumination_share * lit;
   }
   card.categories.push_back({"instrument_handling", bounded(100.0 * progress * handling), o.weight_instrument});
+
+  // Microscope handling (EyeSi's fifth category: the work centred in the field, in focus, at a
+  // sensible zoom): shares of the working time as e-folds, earned by the work like care above. Only
+  // the time a working tip was inside the eye is judged; none judged gives the factor 1.
+  if (t.microscope_measured) {
+    double view = 1.0;
+    if (t.microscope_working_time_s > 0.0) {
+      const double w = t.microscope_working_time_s;
+      auto share = [w](double s) { return std::clamp(s / w, 0.0, 1.0); };
+      view = std::exp(-(o.per_out_of_field * share(t.out_of_field_s) + o.per_off_centre * share(t.off_centre_s) +
+                        o.per_out_of_focus * share(t.out_of_focus_s) + o.per_extreme_zoom * share(t.extreme_zoom_s)));
+    }
+    card.categories.push_back({"microscope_handling", bounded(100.0 * progress * view), o.weight_microscope});
+  }
 
   double sum = 0.0, weights = 0.0;
   for (const auto& c : card.categories) {

@@ -7,8 +7,9 @@
 //   tissue_treatment     forces on the retina (time over the damage limit, impulse, peak) and
 //                        iatrogenic events (tears, lens/wall touches, light toxicity, stray burns)
 //   instrument_handling  instrument collisions, retinal touches, lost grasps, working tips in the light
-// microscope_handling is not scored: the core has no microscope state (zoom, focus, position live in
-// the rig and the renderer). The formulas and their rationale: core/metrics/README.md.
+//   microscope_handling  working tips in the microscope's field, near its centre, in focus, at a usable
+//                        zoom (only when the metrics watch a microscope: SessionMetrics::watch_microscope)
+// The formulas and their rationale: core/metrics/README.md.
 #include <array>
 #include <cstdint>
 #include <string_view>
@@ -24,7 +25,7 @@ inline constexpr std::size_t kInstrumentEventKinds = static_cast<std::size_t>(In
 // What the scores are computed from (SessionMetrics fills it, step by step).
 // The version of the formulas below and in compute_scores (README: Scores): raised whenever a
 // formula, weight or reference changes, so a debrief says which formulas its numbers came from.
-inline constexpr int kScoreFormulaVersion = 1;
+inline constexpr int kScoreFormulaVersion = 2;
 
 struct SessionTotals {
   double elapsed_s = 0.0;
@@ -44,6 +45,18 @@ struct SessionTotals {
   bool illumination_measured = false;        // a light pipe is among the instruments
   double working_time_s = 0.0;               // instrument-seconds of non-light instruments inside
   double lit_working_time_s = 0.0;           // ... with the tip inside the light cone
+  // Microscope handling, when the metrics watch the microscope: instrument-seconds of the working
+  // (non-light) instruments' tips at work inside the eye (MetricsOptions::work_clearance_mm), and
+  // of those the time out of the field of view,
+  // ∫ c² dt, c = (min(r, 1) − r₀) / (1 − r₀) beyond r₀ = MetricsOptions::centre_radius, else 0 (r: the
+  // tip's distance from the field's centre over the field's radius), the
+  // time out of the depth of field and the time at an extreme zoom (MetricsOptions::extreme_zoom).
+  bool microscope_measured = false;
+  double microscope_working_time_s = 0.0;
+  double out_of_field_s = 0.0;
+  double off_centre_s = 0.0;
+  double out_of_focus_s = 0.0;
+  double extreme_zoom_s = 0.0;
 
   std::uint32_t count(InstrumentEventKind k) const { return events[static_cast<std::size_t>(k)]; }
   // Events that harm the eye or show loss of control: excessive retina force, unintended tears,
@@ -59,6 +72,7 @@ struct ScoreOptions {
   double weight_efficiency = 0.2;
   double weight_tissue = 0.25;
   double weight_instrument = 0.15;
+  double weight_microscope = 0.1;
 
   // Efficiency: time / path per unit of progress at which that half of the category gives half credit.
   double reference_time_s = 300.0;   // used when the case has no time limit (else the limit)
@@ -84,6 +98,13 @@ struct ScoreOptions {
   double per_grasp_lost = 0.2;
   double illumination_share = 0.5;
 
+  // Microscope handling: e-folds for the whole working time spent out of the field, at the field's
+  // edge (∫ c² dt over the working time, SessionTotals::off_centre_s), out of focus and at an extreme zoom.
+  double per_out_of_field = 2.0;
+  double per_off_centre = 0.5;
+  double per_out_of_focus = 1.0;
+  double per_extreme_zoom = 1.0;
+
   void validate() const;  // throws InvalidArgument (negative or non-finite values, all weights 0)
 };
 
@@ -99,7 +120,7 @@ struct ScoreCard {
   const ScoreEntry* find(std::string_view name) const;
 };
 
-// Fills card (no allocation once it has room for four categories). time_limit_s: the case's limit,
+// Fills card (no allocation once it has room for five categories). time_limit_s: the case's limit,
 // 0 when it has none.
 void compute_scores(const SessionTotals& totals, const std::vector<CriterionProgress>& criteria, double time_limit_s,
                     const ScoreOptions& options, ScoreCard& card);

@@ -13,6 +13,9 @@ void MetricsOptions::validate() const {
   require_range(retina_force_limit_un, -1e12, 1e12, "metrics: retina_force_limit_un");
   require_range(laser_target_band_mm, 0.0, 10.0, "metrics: laser_target_band_mm");
   require_range(odometer_stride_mm, 0.0, 1.0, "metrics: odometer_stride_mm");
+  require_range(extreme_zoom, 1.0, 1e3, "metrics: extreme_zoom");
+  require_range(work_clearance_mm, 0.0, 30.0, "metrics: work_clearance_mm");
+  require_range(centre_radius, 0.0, 0.99, "metrics: centre_radius");
   require_range(static_cast<double>(completion_check_steps), 1.0, 1e6, "metrics: completion_check_steps");
   progress.validate();
   scores.validate();
@@ -48,7 +51,13 @@ SessionMetrics::SessionMetrics(const TissueWorld& world, MetricsCase c, const Si
   }
   if (!(totals_.force_limit_un > 0.0)) totals_.force_limit_un = InstrumentSceneOptions{}.retina_force_limit_un;
   last_world_step_ = world_.step_count();
-  card_.categories.reserve(4);
+  card_.categories.reserve(5);
+}
+
+void SessionMetrics::watch_microscope(const Microscope* microscope, const EyeModel* eye) {
+  microscope_ = microscope && eye ? microscope : nullptr;
+  eye_ = microscope_ ? eye : nullptr;
+  totals_.microscope_measured = microscope_ != nullptr;
 }
 
 Status SessionMetrics::observe(double dt) {
@@ -93,6 +102,10 @@ void SessionMetrics::accumulate(double dt) {
   const double limit = totals_.force_limit_un;
   const LightExposure& light = sim_->light();
   const double cos_cone = std::cos(light.half_angle_rad);
+  // The microscope's view, worked out once this step, when a working tip is there to be judged.
+  MicroscopeView view;
+  bool have_view = false;
+  glance_ = MicroscopeGlance{};
   for (std::uint32_t i = 0; i < per_instrument_.size(); ++i) {
     const InstrumentState& st = sim_->instrument(i);
     InstrumentMetrics& m = per_instrument_[i];
@@ -142,6 +155,27 @@ void SessionMetrics::accumulate(double dt) {
         if (d > 0.0 && to.dot(light.axis) >= cos_cone * d) totals_.lit_working_time_s += dt;
       }
     }
+
+    // Microscope handling: a working tip at work is what the field should hold — in the field,
+    // near its centre, within the depth of field, at a usable zoom.
+    if (microscope_ && st.inside && st.description.kind != InstrumentKind::kLightPipe && at_work(st)) {
+      if (!have_view) {
+        view = microscope_->view(*eye_);
+        have_view = true;
+        glance_.judged = true;
+        glance_.depth_of_field_mm = view.depth_of_field_mm;
+      }
+      const double r = view.field_radius(st.frame.tip);
+      glance_.field_radius = std::max(glance_.field_radius, r);
+      glance_.defocus_mm = std::max(glance_.defocus_mm, std::abs(view.defocus_mm(st.frame.tip)));
+      totals_.microscope_working_time_s += dt;
+      if (!(r <= 1.0)) totals_.out_of_field_s += dt;
+      // Off centre: 0 within the central part of the field, rising as the square to 1 at its edge.
+      const double c = std::max(0.0, std::min(r, 1.0) - options_.centre_radius) / (1.0 - options_.centre_radius);
+      totals_.off_centre_s += c * c * dt;
+      if (!view.in_focus(st.frame.tip)) totals_.out_of_focus_s += dt;
+      if (microscope_->zoom() > options_.extreme_zoom) totals_.extreme_zoom_s += dt;
+    }
   }
 
   for (const InstrumentEvent& e : sim_->events()) {
@@ -158,6 +192,20 @@ void SessionMetrics::accumulate(double dt) {
     }
   }
   return;
+}
+
+bool SessionMetrics::at_work(const InstrumentState& st) const {
+  using K = InstrumentKind;
+  const K k = st.description.kind;
+  // Holding tissue or touching the retina (not brushing through the gel on the way).
+  if (st.grip != kNone || st.retina_force_un > options_.contact_force_un) return true;
+  if ((k == K::kVitrector || k == K::kDrainageNeedle) && st.input.pedal > 0.0) return true;      // aspirating, cutting
+  if (k == K::kEndolaser && st.input.trigger) return true;                                      // firing
+  // Near the retina: close to the wall behind the ora serrata (the ports lie in front of it, so
+  // entering the eye is not work).
+  const Vec3 from_centre = st.frame.tip - eye_->wall.center();
+  const double polar = std::atan2(Vec2(from_centre.x(), from_centre.y()).norm(), -from_centre.z());
+  return polar < eye_->ora_polar_rad && eye_->wall.clearance(st.frame.tip) <= options_.work_clearance_mm;
 }
 
 const std::vector<CriterionProgress>& SessionMetrics::criteria() {

@@ -20,6 +20,7 @@
 #include "core/sim/simulation.hpp"
 #include "core/metrics/case_progress.hpp"
 #include "core/metrics/score_card.hpp"
+#include "core/scene/microscope.hpp"
 #include "core/scene/scene_builder.hpp"
 
 namespace vitreo::core {
@@ -37,6 +38,17 @@ struct MetricsOptions {
   double retina_force_limit_un = 0.0;
   // A burn counts as on target within this distance (along the wall) of a laser-ring guide.
   double laser_target_band_mm = 0.5;
+  // Microscope handling: a zoom above this is extreme while working (24× total at the default 4×
+  // at zoom 1, the top of an ophthalmic microscope's range: a field of about 2.4 mm on the fundus
+  // in the contact-lens view, which a working tip keeps leaving).
+  double extreme_zoom = 6.0;
+  // A working tip is at work — and judged in the microscope's view — while it acts on tissue
+  // (holds it, touches the retina, aspirates, fires) or is within this of the retina (mm from the wall,
+  // behind the ora serrata): not while it travels from its port through the periphery to the work.
+  double work_clearance_mm = 2.0;
+  // The work is centred while within this share of the field's radius; beyond it, off centre
+  // counts up to 1 at the edge (see SessionTotals::off_centre_s).
+  double centre_radius = 0.5;
   ProgressOptions progress;
   ScoreOptions scores;
   void validate() const;  // throws InvalidArgument
@@ -53,6 +65,15 @@ struct InstrumentMetrics {
   bool touching_retina = false;           // now
 };
 
+// What the microscope showed of the work at the last observed step (the instructor's overlay):
+// the working tip farthest off the field's centre and the one farthest from the focal plane.
+struct MicroscopeGlance {
+  bool judged = false;            // a working tip was inside the eye
+  double field_radius = 0.0;      // largest: 0 centre, 1 the field's edge
+  double defocus_mm = 0.0;        // largest |distance from the focal plane|
+  double depth_of_field_mm = 0.0; // total
+};
+
 class SessionMetrics final : public StepObserver {
  public:
   // From a built scene; sim may be null (tissue-only metrics). The metrics keep references to the
@@ -62,6 +83,11 @@ class SessionMetrics final : public StepObserver {
   // From a world built another way (core/anatomy/retina_cap), described by hand.
   SessionMetrics(const TissueWorld& world, MetricsCase c, const Simulation* sim, MetricsOptions options = {});
 
+  // The microscope whose view the working tips are judged in (microscope_handling), on this eye;
+  // both must outlive the metrics (or be replaced). Without one that category is not scored. Call
+  // before the first observe(), or the time before it goes unjudged.
+  void watch_microscope(const Microscope* microscope, const EyeModel* eye);
+
   // Once after each physics step (Simulation::step or TissueWorld::step) of dt_s seconds.
   // Refuses (changing nothing) a dt that is not finite and in (0, 0.02], and a second call without a
   // world step in between (it would count the step's events twice).
@@ -70,6 +96,7 @@ class SessionMetrics final : public StepObserver {
   void after_step(double dt_s) override { (void)observe(dt_s); }
 
   const SessionTotals& totals() const { return totals_; }
+  const MicroscopeGlance& microscope_glance() const { return glance_; }
   const InstrumentMetrics& instrument(std::uint32_t i) const { return per_instrument_.at(i); }
   std::uint32_t instrument_count() const { return static_cast<std::uint32_t>(per_instrument_.size()); }
   TissueProgress tissue() const { return progress_.tissue(world_); }
@@ -90,9 +117,14 @@ class SessionMetrics final : public StepObserver {
 
  private:
   void accumulate(double dt);
+  // A working tip at work (MetricsOptions::work_clearance_mm); needs the watched eye.
+  bool at_work(const InstrumentState& st) const;
 
   const TissueWorld& world_;
   const Simulation* sim_;
+  const Microscope* microscope_ = nullptr;
+  const EyeModel* eye_ = nullptr;
+  MicroscopeGlance glance_;
   MetricsOptions options_;
   CaseProgress progress_;
   SessionTotals totals_;

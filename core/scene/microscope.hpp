@@ -14,6 +14,8 @@
 // fundus +x to the right and +y up at the field centre, so the joystick's right/up are the image's.
 // Focus is the offset of the focal plane from the fundus at the field centre, + toward the
 // microscope (into the vitreous: an elevated retina or a membrane comes into focus).
+#include <cmath>
+
 #include "core/common/state_hasher.hpp"
 #include "core/common/types.hpp"
 
@@ -29,9 +31,48 @@ struct MicroscopeSettings {
   double pan_travel_mm = 20.0;      // the field centre stays within this of the posterior pole (fundus plane)
   double field_deg = 40.0;          // field angle at zoom 1 through the contact lens (standard view)
   double wide_field_deg = 110.0;    // field angle at zoom 1 through the wide-angle (BIOM-like) system
+  // The optics behind the depth of field (MicroscopeView::depth_of_field_mm): the numerical
+  // aperture of one stereo channel on the object side (a pupil of about 9 mm at a 180 mm working
+  // distance) and the total visual magnification at zoom 1 (ophthalmic microscopes start at about
+  // 4× with 12.5× eyepieces).
+  double numerical_aperture = 0.025;
+  double magnification_at_zoom_1 = 4.0;
 
   void validate() const;  // throws InvalidArgument naming the field
 };
+
+// What the microscope sees now, in the eye frame, as the renderer draws it
+// (rig/session/frame_source.cpp builds its camera from this): the view through the eye's optics is
+// a centre of projection on the optical axis just behind the lens, aimed at the field centre on the
+// retina's inner surface, with a circular field of half-angle atan(tan(field at zoom 1 / 2) / zoom).
+// The refraction of the contact lens or the wide-angle system is not modelled (the renderer does
+// not either); it enters only the depth of field, through the view's lateral magnification.
+struct MicroscopeView {
+  Vec3 eye_point_mm = Vec3::Zero();  // centre of projection
+  Vec3 target_mm = Vec3::Zero();     // field centre, on the retina's inner surface
+  Vec3 axis = -Vec3::UnitZ();        // unit, from the eye point toward the target
+  Vec3 up = Vec3::UnitY();           // unit, normal to the axis: fundus +y at the field centre
+  double half_tan = 1.0;             // tan of the field's half angle
+  double focal_distance_mm = 0.0;    // eye point to the focal plane, along the axis
+  double depth_of_field_mm = 0.0;    // total, centred on the focal plane
+
+  // Where p lies across the field: 0 on the axis, 1 at the field's edge (tan of its angle off the
+  // axis over half_tan); +infinity for a point not in front of the eye point.
+  double field_radius(const Vec3& p) const;
+  // Its distance from the focal plane along the axis, + beyond it (toward the fundus).
+  double defocus_mm(const Vec3& p) const { return (p - eye_point_mm).dot(axis) - focal_distance_mm; }
+  bool in_field(const Vec3& p) const { return field_radius(p) <= 1.0; }
+  bool in_focus(const Vec3& p) const { return std::abs(defocus_mm(p)) <= 0.5 * depth_of_field_mm; }
+};
+
+// The visual depth of field (mm) at the fundus: Berek's formula for the microscope at its total
+// magnification, T = λ/(2·NA²) + 0.34 mm/(NA·M) (λ = 0.55 µm), carried into the eye through the
+// viewing optics: axial magnification is the square of the lateral one, and the object lies in the
+// vitreous cavity (n = 1.336), so T_eye = n · T / m². m = 1 through the contact lens; the wide-angle
+// system fits a wider field into the same image, m = tan(field/2) / tan(wide field/2).
+double depth_of_field_mm(const MicroscopeSettings& settings, double zoom, bool wide_angle);
+
+struct EyeModel;
 
 // The microscope pedal's joystick for one step: deflection −1..1 per axis (after the dead band),
 // +x toward the image's right, +y toward its top.
@@ -68,6 +109,9 @@ class Microscope {
   bool image_inverted() const { return wide_angle_ && !reinverter_; }
   // Full field angle now (deg): the optics' field over the magnification.
   double field_deg() const;
+  // The view now, on this eye (see MicroscopeView).
+  MicroscopeView view(const EyeModel& eye) const;
+  double depth_of_field_mm() const { return vitreo::core::depth_of_field_mm(settings_, zoom_, wide_angle_); }
   const MicroscopeSettings& settings() const { return settings_; }
 
   void hash_into(StateHasher& h) const;

@@ -101,6 +101,12 @@ core::SessionTotals as_core_totals(const TotalsRecord& t) {
   c.illumination_measured = t.illumination_measured;
   c.working_time_s = t.working_time_s;
   c.lit_working_time_s = t.lit_working_time_s;
+  c.microscope_measured = t.microscope_measured;
+  c.microscope_working_time_s = t.microscope_working_time_s;
+  c.out_of_field_s = t.out_of_field_s;
+  c.off_centre_s = t.off_centre_s;
+  c.out_of_focus_s = t.out_of_focus_s;
+  c.extreme_zoom_s = t.extreme_zoom_s;
   return c;
 }
 
@@ -189,6 +195,21 @@ void write_category_inputs(JsonWriter& j, const std::string& name, const TotalsR
     j.key("illumination_measured").value(t.illumination_measured);
     j.field("lit_share", t.working_time_s > 0 ? t.lit_working_time_s / t.working_time_s : 1.0, "share (0..1)");
     j.field("s_illumination_share", t.illumination_measured ? o.illumination_share : 0.0, "share (0..1)");
+  } else if (name == "microscope_handling") {
+    j.key("formula").value("100 * P * exp(-V), V = 2.0 * out_of_field + 0.5 * off_centre + 1.0 * out_of_focus + 1.0 * extreme_zoom (shares of W)");
+    const double w = t.microscope_working_time_s;
+    auto share = [w](double s) { return w > 0 ? std::clamp(s / w, 0.0, 1.0) : 0.0; };
+    j.field("W_working_time", w, "s");
+    j.field("out_of_field_share", share(t.out_of_field_s), "share (0..1)");
+    j.field("off_centre_share", share(t.off_centre_s), "share (0..1): mean c^2, c = (min(r,1) - 0.5)/0.5 beyond half the field radius");
+    j.field("out_of_focus_share", share(t.out_of_focus_s), "share (0..1)");
+    j.field("extreme_zoom_share", share(t.extreme_zoom_s), "share (0..1)");
+    j.key("view_terms").begin_object();
+    j.field("out_of_field", o.per_out_of_field * share(t.out_of_field_s), "e-folds");
+    j.field("off_centre", o.per_off_centre * share(t.off_centre_s), "e-folds");
+    j.field("out_of_focus", o.per_out_of_focus * share(t.out_of_focus_s), "e-folds");
+    j.field("extreme_zoom", o.per_extreme_zoom * share(t.extreme_zoom_s), "e-folds");
+    j.end_object();
   }
   j.end_object();
 }
@@ -328,6 +349,12 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     j.field("iatrogenic_events", t.iatrogenic_events, "count");
     j.field("working_time", t.working_time_s, "s");
     j.field("lit_working_time", t.lit_working_time_s, "s");
+    j.key("microscope_measured").value(t.microscope_measured);
+    j.field("microscope_working_time", t.microscope_working_time_s, "s");
+    j.field("out_of_field", t.out_of_field_s, "s");
+    j.field("off_centre", t.off_centre_s, "s (integral of c^2)");
+    j.field("out_of_focus", t.out_of_focus_s, "s");
+    j.field("extreme_zoom", t.extreme_zoom_s, "s");
     j.key("events_by_kind").begin_object();
     for (const auto& [k, n] : t.events_by_kind) j.field(k, n, "count");
     j.end_object();

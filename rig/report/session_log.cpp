@@ -100,6 +100,12 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     r.illumination_measured = m.illumination_measured;
     r.working_time_s = m.working_time_s;
     r.lit_working_time_s = m.lit_working_time_s;
+    r.microscope_measured = m.microscope_measured;
+    r.microscope_working_time_s = m.microscope_working_time_s;
+    r.out_of_field_s = m.out_of_field_s;
+    r.off_centre_s = m.off_centre_s;
+    r.out_of_focus_s = m.out_of_focus_s;
+    r.extreme_zoom_s = m.extreme_zoom_s;
     for (std::size_t i = 0; i < static_cast<std::size_t>(m.n_kinds); ++i) r.events_by_kind.emplace_back(m.event_kind[i], m.event_count[i]);
     for (std::size_t i = 0; i < static_cast<std::size_t>(m.n_instruments); ++i)
       r.instruments.push_back({m.instrument_kind[i], m.instrument_path_mm[i], m.instrument_peak_force_un[i],

@@ -77,6 +77,8 @@ struct TotalsRecord {
   std::int32_t burns_on_target = 0, burns_elsewhere = 0, retina_tears = 0, other_tears = 0, iatrogenic_events = 0;
   bool illumination_measured = false;
   double working_time_s = 0, lit_working_time_s = 0;
+  bool microscope_measured = false;
+  double microscope_working_time_s = 0, out_of_field_s = 0, off_centre_s = 0, out_of_focus_s = 0, extreme_zoom_s = 0;
   std::vector<std::pair<std::string, std::int32_t>> events_by_kind;
   std::vector<InstrumentTotals> instruments;
 };

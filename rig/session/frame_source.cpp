@@ -295,6 +295,14 @@ void capture_progress(SimulationModel& model, ViewSnapshot& out) {
   }
   const core::SessionTotals& totals = metrics.totals();
   o.elapsed_s = totals.elapsed_s;
+  const core::MicroscopeGlance& glance = metrics.microscope_glance();
+  o.scope_judged = glance.judged;
+  o.scope_field_radius = glance.field_radius;
+  o.scope_defocus_mm = glance.defocus_mm;
+  o.scope_depth_of_field_mm = glance.depth_of_field_mm;
+  const double w = totals.microscope_working_time_s;
+  o.out_of_field_share = w > 0.0 ? totals.out_of_field_s / w : 0.0;
+  o.out_of_focus_share = w > 0.0 ? totals.out_of_focus_s / w : 0.0;
   o.force_limit_un = totals.force_limit_un;
   o.retina_contacts = totals.retina_contacts;
   o.iatrogenic_events = totals.iatrogenic_events();
@@ -489,6 +497,24 @@ void FrameBuilder::add_overlay(const ViewSnapshot& snap, const CaseVisuals& cv, 
     ov.lines.emplace_back(line);
   }
   std::snprintf(line, sizeof line, "RETINAL CONTACTS %u  IATROGENIC EVENTS %u", o.retina_contacts, o.iatrogenic_events);
+  ov.lines.emplace_back(line);
+  // Microscope handling's inputs: zoom and focus now, where the work lies in the view (field radius
+  // 1 = its edge; off the focal plane against half the depth of field), and the shares so far.
+  std::snprintf(line, sizeof line, "MICROSCOPE ZOOM %.1f  FOCUS %+.1f MM  DEPTH OF FIELD %.1f MM", snap.zoom, snap.focus_mm,
+                o.scope_depth_of_field_mm);
+  ov.lines.emplace_back(line);
+  if (o.scope_judged) {
+    const bool in_field = o.scope_field_radius <= 1.0, in_focus = o.scope_defocus_mm <= 0.5 * o.scope_depth_of_field_mm;
+    if (in_field) {
+      std::snprintf(line, sizeof line, "TIP %s AT %.0f%% OF THE FIELD RADIUS, %s", "IN FIELD", 100.0 * o.scope_field_radius,
+                    in_focus ? "IN FOCUS" : "OUT OF FOCUS");
+    } else {
+      std::snprintf(line, sizeof line, "TIP OUT OF THE FIELD, %s", in_focus ? "IN FOCUS" : "OUT OF FOCUS");
+    }
+    ov.lines.emplace_back(line);
+  }
+  std::snprintf(line, sizeof line, "WORK OUT OF FIELD %.0f%%  OUT OF FOCUS %.0f%%", 100.0 * o.out_of_field_share,
+                100.0 * o.out_of_focus_share);
   ov.lines.emplace_back(line);
   ov.retina_force_un = static_cast<float>(o.retina_force_un);
   ov.force_limit_un = static_cast<float>(o.force_limit_un > 0.0 ? o.force_limit_un : 3000.0);

@@ -41,6 +41,8 @@ void SimulationModel::install(std::unique_ptr<PreparedCase> c) {
   // The microscope starts centred on the case's region of interest.
   microscope_ = core::Microscope(config_.microscope, case_->scene->eye.fundus_coords(case_->focus_mm),
                                  case_->scene->description.view.wide_angle);
+  // The case's metrics judge the work in this microscope's view (microscope_handling).
+  case_->metrics->watch_microscope(&microscope_, &case_->scene->eye);
   ++case_loads_;
 }
 

@@ -60,6 +60,9 @@ class SimulationModel {
   // Loads config.first_case in place (allocates, may settle), or starts from one already prepared.
   explicit SimulationModel(const ModelConfig& config);
   SimulationModel(const ModelConfig& config, std::unique_ptr<PreparedCase> first);
+  // The case's metrics hold a pointer to the microscope: the model stays where it was built.
+  SimulationModel(SimulationModel&&) = delete;
+  SimulationModel& operator=(SimulationModel&&) = delete;
 
   // Applies one recorded input. Returns false for an input it refuses (non-finite values, bad
   // quaternion, a case or setting out of range): the refusal is counted and the state is unchanged.

@@ -61,6 +61,11 @@ struct OverlaySnapshot {
   std::uint32_t iatrogenic_events = 0;
   std::uint32_t event_counts[kMaxEventKinds] = {};  // by core::InstrumentEventKind
   std::uint32_t retina_tears = 0;
+  // Microscope handling's inputs: the last step's view of the work (core::MicroscopeGlance) and
+  // the shares of the working time so far out of the field and out of focus.
+  bool scope_judged = false;
+  double scope_field_radius = 0.0, scope_defocus_mm = 0.0, scope_depth_of_field_mm = 0.0;
+  double out_of_field_share = 0.0, out_of_focus_share = 0.0;
 };
 
 struct ViewSnapshot {

@@ -130,6 +130,12 @@ Totals totals_item(const core::SessionMetrics& m, std::string_view case_id, std:
   o.illumination_measured = t.illumination_measured;
   o.working_time_s = t.working_time_s;
   o.lit_working_time_s = t.lit_working_time_s;
+  o.microscope_measured = t.microscope_measured;
+  o.microscope_working_time_s = t.microscope_working_time_s;
+  o.out_of_field_s = t.out_of_field_s;
+  o.off_centre_s = t.off_centre_s;
+  o.out_of_focus_s = t.out_of_focus_s;
+  o.extreme_zoom_s = t.extreme_zoom_s;
   for (std::size_t k = 0; k < core::kInstrumentEventKinds && o.n_kinds < Totals::kMaxKinds; ++k) {
     copy_text(o.event_kind[o.n_kinds], event_key(static_cast<core::InstrumentEventKind>(k)));
     o.event_count[o.n_kinds++] = static_cast<std::int32_t>(t.events[k]);
@@ -395,6 +401,12 @@ vitreo_lcm::session_totals_t to_lcm(const Totals& v, std::int64_t utime_us) {
   m.illumination_measured = v.illumination_measured;
   m.working_time_s = v.working_time_s;
   m.lit_working_time_s = v.lit_working_time_s;
+  m.microscope_measured = v.microscope_measured;
+  m.microscope_working_time_s = v.microscope_working_time_s;
+  m.out_of_field_s = v.out_of_field_s;
+  m.off_centre_s = v.off_centre_s;
+  m.out_of_focus_s = v.out_of_focus_s;
+  m.extreme_zoom_s = v.extreme_zoom_s;
   const std::size_t nk = std::min<std::size_t>(v.n_kinds, Totals::kMaxKinds);
   m.n_kinds = static_cast<std::int16_t>(nk);
   for (std::size_t i = 0; i < nk; ++i) {

@@ -171,12 +171,68 @@ TEST(Scores, ClumsinessAndWorkingInTheDarkLowerInstrumentHandling) {
   EXPECT_GT(category(t, "instrument_handling"), base);
 }
 
+SessionTotals watched() {
+  SessionTotals t = ordinary();
+  t.microscope_measured = true;
+  t.microscope_working_time_s = 100.0;
+  t.out_of_field_s = 10.0;
+  t.off_centre_s = 20.0;
+  t.out_of_focus_s = 5.0;
+  t.extreme_zoom_s = 0.0;
+  return t;
+}
+
+// Microscope handling (README: Scores), worked by hand: shares of the 100 s working time out of the
+// field 0.1, mean min(r,1)² 0.2, out of focus 0.05 → 2·0.1 + 0.5·0.2 + 1·0.05 = 0.35 e-folds, times
+// the progress 0.375.
+TEST(Scores, MicroscopeHandlingJudgesTheWorkInTheFieldAndInFocus) {
+  EXPECT_NEAR(category(watched(), "microscope_handling"), 37.5 * std::exp(-0.35), 1e-9);
+  ScoreCard card;
+  compute_scores(watched(), half_done(), 600.0, ScoreOptions{}, card);
+  ASSERT_EQ(card.categories.size(), 5u);
+  EXPECT_STREQ(card.categories.back().name, "microscope_handling");
+  double sum = 0.0, weights = 0.0;
+  for (const auto& e : card.categories) {
+    sum += e.weight * e.value;
+    weights += e.weight;
+  }
+  EXPECT_NEAR(weights, 0.4 + 0.2 + 0.25 + 0.15 + 0.1, 1e-12);
+  EXPECT_NEAR(card.total, sum / weights, 1e-9);
+
+  // Every input strictly lowers it: each of the four kinds of time.
+  const double base = category(watched(), "microscope_handling");
+  for (double SessionTotals::*field : {&SessionTotals::out_of_field_s, &SessionTotals::off_centre_s, &SessionTotals::out_of_focus_s,
+                                       &SessionTotals::extreme_zoom_s}) {
+    SessionTotals t = watched();
+    t.*field += 1.0;
+    EXPECT_LT(category(t, "microscope_handling"), base);
+  }
+  // Out of the field for the whole working time: at most e⁻² of the progress.
+  SessionTotals lost = watched();
+  lost.out_of_field_s = lost.off_centre_s = 100.0;
+  lost.out_of_focus_s = 0.0;
+  EXPECT_NEAR(category(lost, "microscope_handling"), 37.5 * std::exp(-2.5), 1e-9);
+  // Earned by the work: no progress, no score, however well the field was held.
+  auto none = half_done();
+  none[0].progress = none[1].progress = 0.0;
+  SessionTotals perfect = watched();
+  perfect.out_of_field_s = perfect.off_centre_s = perfect.out_of_focus_s = 0.0;
+  EXPECT_EQ(category(perfect, "microscope_handling", none), 0.0);
+  EXPECT_NEAR(category(perfect, "microscope_handling"), 37.5, 1e-12);
+  // No microscope watched: the category is not scored at all.
+  compute_scores(ordinary(), half_done(), 600.0, ScoreOptions{}, card);
+  EXPECT_EQ(card.find("microscope_handling"), nullptr);
+}
+
 TEST(Scores, BadOptionsAreRefused) {
   ScoreOptions o;
   o.per_retina_tear = -1.0;
   EXPECT_THROW(o.validate(), InvalidArgument);
   o = ScoreOptions{};
-  o.weight_target = o.weight_efficiency = o.weight_tissue = o.weight_instrument = 0.0;
+  o.weight_target = o.weight_efficiency = o.weight_tissue = o.weight_instrument = o.weight_microscope = 0.0;
+  EXPECT_THROW(o.validate(), InvalidArgument);
+  o = ScoreOptions{};
+  o.per_out_of_field = -0.5;
   EXPECT_THROW(o.validate(), InvalidArgument);
   o = ScoreOptions{};
   o.reference_path_mm = std::nan("");

@@ -307,10 +307,78 @@ TEST(SessionMetrics, PressingLongerLowersTissueTreatmentAndLongerPathsLowerEffic
       EXPECT_GE(e.value, 0.0);
       EXPECT_LE(e.value, 100.0);
     }
-    // No criteria: nothing to achieve, so no target_achievement; never a microscope score.
+    // No criteria: nothing to achieve, so no target_achievement; no microscope watched, no microscope score.
     EXPECT_EQ(c->find("target_achievement"), nullptr);
     EXPECT_EQ(c->find("microscope_handling"), nullptr);
   }
+}
+
+// Microscope handling on a scripted tip: the view centred on the posterior pole of a (small) eye
+// model, at zoom 2, looks down −z from just behind its lens, so where a tip lies in the field and in
+// the depth of field follows from its position by hand (field half-angle tan 20° / 2; Berek's depth
+// of field 1.336 · (0.44 + 1.7) = 2.859 mm, microscope_test.cpp). A tip is judged while at work:
+// near the retina (within 2 mm), or acting (here: the flute needle aspirating). Phases, 1 mm above
+// the retina unless said: 100 steps at 0.4 field radii (centred: within half the radius); 100 at
+// 0.75 (off centre (0.75 − 0.5) / 0.5 = 0.5, squared 0.25); 200 at 1.5 (out of the field, in
+// focus); 100 steps on the axis 3 mm above the retina aspirating (in the field, out of focus); 100
+// steps there not aspirating (travelling: not judged); 50 steps out of the eye.
+TEST(SessionMetrics, MicroscopeHandlingTimesTheWorkOutOfTheFieldAndOutOfFocus) {
+  EyeParameters p;
+  p.retina_vertices = 500;
+  p.gel_shells = 0;
+  const EyeModel eye = build_eye_model(p);
+  Microscope scope(MicroscopeSettings{}, Vec2::Zero());
+  scope.set_zoom(2.0);
+  for (int i = 0; i < 1000; ++i) scope.step(kDt, {});
+  ASSERT_EQ(scope.zoom(), 2.0);
+  const double eye_z = eye.lens_center_z_mm - 0.5 * p.lens_thickness_mm - 0.5;
+  const double retina_z = -eye.wall.radius_toward(-Vec3::UnitZ()) + p.retina_thickness_mm;
+  const double half_tan = std::tan(20.0 * kPi / 180.0) / 2.0;
+  const double near_z = retina_z + 1.0, high_z = retina_z + 3.0;
+  const auto at_radius = [&](double r) { return Vec3(r * half_tan * (eye_z - near_z), 0.0, near_z); };
+  const Vec3 centre = at_radius(0.4), off = at_radius(0.75), aside = at_radius(1.5), high(0.0, 0.0, high_z);
+  ASSERT_LE(eye.wall.clearance(aside), 2.0) << "the tip beside the field still works near the retina";
+  ASSERT_GT(eye.wall.clearance(high), 2.0);
+
+  Bench b(InstrumentKind::kDrainageNeedle, -11.5);  // the bench's sheet lies below the eye model's retina
+  SessionMetrics m(b.world, b.metrics_case(), b.instruments.get());
+  m.watch_microscope(&scope, &eye);
+  const auto step = [&](const Vec3& at, double pedal, bool present = true) {
+    InstrumentInput in;
+    in.tip_fixture_mm = at;
+    in.axis_fixture = (at - kPort).normalized();
+    in.pedal = pedal;
+    in.present = present;
+    ASSERT_TRUE(b.instruments->set_input(0, in));
+    b.instruments->step(kDt);
+    ASSERT_TRUE(m.observe(kDt));
+  };
+  for (int k = 0; k < 100; ++k) step(centre, 0.0);
+  EXPECT_TRUE(m.microscope_glance().judged);
+  EXPECT_NEAR(m.microscope_glance().field_radius, 0.4, 1e-9);
+  EXPECT_NEAR(m.microscope_glance().defocus_mm, 1.0, 1e-9);
+  EXPECT_EQ(m.totals().off_centre_s, 0.0);
+  for (int k = 0; k < 100; ++k) step(off, 0.0);
+  for (int k = 0; k < 200; ++k) step(aside, 0.0);
+  EXPECT_NEAR(m.microscope_glance().field_radius, 1.5, 1e-9);
+  for (int k = 0; k < 100; ++k) step(high, 0.5);
+  EXPECT_NEAR(m.microscope_glance().defocus_mm, 3.0, 1e-9);
+  for (int k = 0; k < 100; ++k) step(high, 0.0);
+  EXPECT_FALSE(m.microscope_glance().judged) << "travelling, not at work";
+  for (int k = 0; k < 50; ++k) step(Vec3(0.0, 0.0, 20.0), 0.0, false);
+  EXPECT_FALSE(m.microscope_glance().judged);
+
+  const SessionTotals& t = m.totals();
+  ASSERT_TRUE(t.microscope_measured);
+  EXPECT_NEAR(t.microscope_working_time_s, 0.5, 1e-9);
+  EXPECT_NEAR(t.out_of_field_s, 0.2, 1e-9);
+  EXPECT_NEAR(t.off_centre_s, 0.1 * 0.25 + 0.2, 1e-9);
+  EXPECT_NEAR(t.out_of_focus_s, 0.1, 1e-9);
+  EXPECT_EQ(t.extreme_zoom_s, 0.0);
+  // No criteria (P = 1): 100 · exp(−(2 · 0.4 + 0.5 · 0.45 + 1 · 0.2)).
+  const ScoreEntry* e = m.score().find("microscope_handling");
+  ASSERT_NE(e, nullptr);
+  EXPECT_NEAR(e->value, 100.0 * std::exp(-1.225), 1e-9);
 }
 
 }  // namespace

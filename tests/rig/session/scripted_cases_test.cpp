@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include <unistd.h>
+
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/session/rig_session.hpp"
 #include "rig/session/scripted_session.hpp"
@@ -50,8 +52,9 @@ struct Played {
 };
 
 // tremor_mm, when given, replaces the script's tremor σ: the degradation sweep plays the expert's
-// motions with a shakier hand.
-Played play(const std::string& case_name, const fs::path& script_file, const std::string& tag, double tremor_mm = -1.0) {
+// motions with a shakier hand. typed: operator commands typed on the rig's terminal at the start.
+Played play(const std::string& case_name, const fs::path& script_file, const std::string& tag, double tremor_mm = -1.0,
+            const std::string& typed = "") {
   Played out;
   out.script = read_surgical_script(script_file.string());
   if (tremor_mm >= 0.0) out.script.tremor_mm = tremor_mm;
@@ -69,7 +72,17 @@ Played play(const std::string& case_name, const fs::path& script_file, const std
   config.steps = static_cast<std::uint64_t>(std::llround(out.script.duration_s / config.model.dt_s));
   config.lcm_url = "file://" + (dir / "telemetry.lcmlog").string() + "?mode=w";
   config.command_echo = nullptr;
+  int fds[2] = {-1, -1};
+  if (!typed.empty()) {
+    EXPECT_EQ(::pipe(fds), 0);
+    EXPECT_EQ(::write(fds[1], typed.data(), typed.size()), static_cast<ssize_t>(typed.size()));
+    ::close(fds[1]);
+    config.command_fd = fds[0];
+    config.command_echo = std::tmpfile();  // the terminal's acks (it needs somewhere to print them)
+  }
   out.summary = run_session(config);
+  if (fds[0] >= 0) ::close(fds[0]);
+  if (config.command_echo) std::fclose(config.command_echo);
   return out;
 }
 
@@ -79,11 +92,20 @@ double category(const SessionSummary& s, const char* name) {
 }
 
 [[maybe_unused]] std::string line(const char* who, const SessionSummary& s) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "%-7s total %5.1f  target %5.1f  efficiency %5.1f  tissue %5.1f  handling %5.1f  iatrogenic %u  %s",
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "%-7s total %5.1f  target %5.1f  efficiency %5.1f  tissue %5.1f  handling %5.1f  microscope %5.1f  iatrogenic %u  %s",
                 who, s.score.total, category(s, "target_achievement"), category(s, "efficiency"), category(s, "tissue_treatment"),
-                category(s, "instrument_handling"), static_cast<unsigned>(s.totals.iatrogenic_events()),
+                category(s, "instrument_handling"), category(s, "microscope_handling"), static_cast<unsigned>(s.totals.iatrogenic_events()),
                 s.case_completed ? "COMPLETED" : "not completed");
+  // Microscope handling's inputs: shares of the working time out of the field, off centre, out of focus.
+  const double w = s.totals.microscope_working_time_s;
+  if (w > 0.0) {
+    char more[128];
+    std::snprintf(more, sizeof more, "  (work %.1f s: out of field %.0f%%, off centre %.0f%%, out of focus %.0f%%)", w,
+                  100.0 * s.totals.out_of_field_s / w, 100.0 * s.totals.off_centre_s / w, 100.0 * s.totals.out_of_focus_s / w);
+    return std::string(buf) + more;
+  }
   return buf;
 }
 
@@ -143,6 +165,22 @@ TEST_P(ScriptedCase, ExpertCompletesClumsyScoresLowerIdleScoresNothing) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryCase, ScriptedCase, ::testing::ValuesIn(case_names()), [](const auto& p) { return p.param; });
+
+// Microscope handling through the whole stack: the expert's cut with the field where the case puts
+// it, and the same hands after the operator pans the field 8 mm off the path at the start (the
+// terminal's `pan`, before the blade reaches the work): the work out of the field scores lower.
+TEST(MicroscopeHandling, TheExpertsWorkOutOfTheFieldScoresLower) {
+  const std::string name = "exercise_cut_path";
+  const Played centred = play(name, script_path(name, "expert"), "centred");
+  const Played off = play(name, script_path(name, "expert"), "field-off", -1.0, "pan 8 8\n");
+  std::printf("  %s\n  %s\n", line("centred", centred.summary).c_str(), line("off", off.summary).c_str());
+  EXPECT_TRUE(centred.summary.case_completed);
+  EXPECT_GT(category(centred.summary, "microscope_handling"), 80.0) << "the expert keeps the work in the field";
+  EXPECT_EQ(centred.summary.totals.out_of_field_s, 0.0);
+  EXPECT_GT(off.summary.totals.out_of_field_s, 0.5 * off.summary.totals.microscope_working_time_s);
+  EXPECT_LT(category(off.summary, "microscope_handling"), category(centred.summary, "microscope_handling") - 30.0);
+  EXPECT_LT(off.summary.score.total, centred.summary.score.total);
+}
 
 // The expert's script with a growing tremor (σ of the hand's position noise, 20 Hz): the score falls
 // at every step of the sweep. Four full sessions a case, so it runs with VITREO_LONG_TESTS=1.

@@ -246,7 +246,8 @@ TEST(RigSession, ScoresGoOutOnTelemetryAndTheReplayScoresTheSame) {
     ASSERT_EQ(m.n, static_cast<std::int16_t>(m.name.size()));
     std::map<std::string, double> by_name;
     for (int i = 0; i < m.n; ++i) by_name[m.name[static_cast<std::size_t>(i)]] = m.value[static_cast<std::size_t>(i)];
-    EXPECT_TRUE(by_name.count("efficiency") && by_name.count("tissue_treatment") && by_name.count("instrument_handling"));
+    EXPECT_TRUE(by_name.count("efficiency") && by_name.count("tissue_treatment") && by_name.count("instrument_handling") &&
+                by_name.count("microscope_handling"));
     for (const auto& [name, v] : by_name) {
       EXPECT_GE(v, 0.0) << name;
       EXPECT_LE(v, 100.0) << name;

@@ -190,6 +190,12 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   t.illumination_measured = true;
   t.working_time_s = 6;
   t.lit_working_time_s = 4.5;
+  t.microscope_measured = true;
+  t.microscope_working_time_s = 7.25;
+  t.out_of_field_s = 0.5;
+  t.off_centre_s = 1.125;
+  t.out_of_focus_s = 0.75;
+  t.extreme_zoom_s = 0.25;
   t.n_kinds = 2;
   copy_text(t.event_kind[0], "wall_contact");
   t.event_count[0] = 9;
@@ -257,6 +263,12 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   EXPECT_TRUE(tg.illumination_measured);
   EXPECT_DOUBLE_EQ(tg.working_time_s, 6);
   EXPECT_DOUBLE_EQ(tg.lit_working_time_s, 4.5);
+  EXPECT_TRUE(tg.microscope_measured);
+  EXPECT_DOUBLE_EQ(tg.microscope_working_time_s, 7.25);
+  EXPECT_DOUBLE_EQ(tg.out_of_field_s, 0.5);
+  EXPECT_DOUBLE_EQ(tg.off_centre_s, 1.125);
+  EXPECT_DOUBLE_EQ(tg.out_of_focus_s, 0.75);
+  EXPECT_DOUBLE_EQ(tg.extreme_zoom_s, 0.25);
   ASSERT_EQ(tg.n_kinds, 2);
   EXPECT_EQ(tg.event_kind[1], "excessive_retina_force");
   EXPECT_EQ(tg.event_count[0], 9);
