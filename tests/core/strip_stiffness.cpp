@@ -17,6 +17,8 @@ namespace {
 
 constexpr double kDt = 1e-3;
 
+}  // namespace
+
 GlobeWall far_wall() { return GlobeWall::sphere(Vec3::Zero(), 1e6); }
 
 Environment weightless() {
@@ -25,8 +27,6 @@ Environment weightless() {
   env.apply_pressure = false;
   return env;
 }
-
-}  // namespace
 
 TriangleMesh retina_strip(int retina_vertices, double width_mm, double length_mm) {
   RetinaCapOptions o;

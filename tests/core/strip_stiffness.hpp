@@ -13,6 +13,10 @@
 
 namespace vitreo::test {
 
+// A wall too far to touch, and an environment without gravity or pressure: tissue alone.
+core::GlobeWall far_wall();
+core::Environment weightless();
+
 // The retina of the solver benchmark (core/anatomy/retina_cap: a revolved sphere cap, R 12 mm) at
 // the given resolution; the triangles within a band around its equator, W wide across the rings
 // and L long around the axis, laid flat (x along the azimuth, y across the rings). Near the

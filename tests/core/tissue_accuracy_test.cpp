@@ -33,14 +33,8 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDt = 1e-3;
 
-GlobeWall far_wall() { return GlobeWall::sphere(Vec3::Zero(), 1e6); }
-
-Environment weightless() {
-  Environment env;
-  env.gravity_mm_s2 = Vec3::Zero();
-  env.apply_pressure = false;
-  return env;
-}
+using vitreo::test::far_wall;
+using vitreo::test::weightless;
 
 // Steps until nothing is awake (or the time runs out); returns the simulated seconds.
 double settle(TissueWorld& world, double max_s) {
