@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,17 +28,32 @@ std::vector<Row> rates_table() {
   bool in_section = false;
   std::vector<Row> rows;
   // | tracker, per instrument | POSE_SAMPLE | 1000 Hz | 51 000 (51 B) | 7 000 |
-  const std::regex row(R"(^\| ([^|]+) \| ([A-Z_]+) \| ([0-9 ]+) Hz \| ([0-9 ]+) \(([0-9]+) B\) \| ([0-9 ]+) \|$)");
+  // Split on '|' by hand: GCC 12's <regex> trips -Werror=maybe-uninitialized under the sanitizers.
   auto number = [](std::string s) {
     s.erase(std::remove(s.begin(), s.end(), ' '), s.end());
     return std::stol(s);
   };
+  auto trim = [](const std::string& s) {
+    const auto b = s.find_first_not_of(' ');
+    const auto e = s.find_last_not_of(' ');
+    return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+  };
+  auto ends_with = [](const std::string& s, const std::string& tail) {
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+  };
   while (std::getline(in, line)) {
     if (line.rfind("## ", 0) == 0) in_section = line.find("Rates and bus load") != std::string::npos;
-    std::smatch m;
-    if (in_section && std::regex_match(line, m, row)) {
-      rows.push_back({m[1], m[2], number(m[3]), number(m[4]), number(m[5]), number(m[6])});
-    }
+    if (!in_section || line.rfind("| ", 0) != 0) continue;
+    std::vector<std::string> cells;
+    std::stringstream split(line.substr(1));
+    for (std::string cell; std::getline(split, cell, '|');) cells.push_back(trim(cell));
+    if (cells.size() != 5 || !ends_with(cells[2], " Hz")) continue;  // the header row
+    const std::string& serial = cells[3];  // "51 000 (51 B)"
+    const auto open = serial.find('('), close = serial.find(" B)");
+    if (open == std::string::npos || close == std::string::npos) continue;
+    rows.push_back({cells[0], cells[1], number(cells[2].substr(0, cells[2].size() - 3)),
+                    number(serial.substr(0, open)), number(serial.substr(open + 1, close - open - 1)),
+                    number(cells[4])});
   }
   return rows;
 }
