@@ -9,6 +9,7 @@
 //
 // Room for kMaxInstruments instruments is made at construction (no allocation in the step); an
 // instrument index beyond it is refused with an error in last_error().
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -39,11 +40,14 @@ class TopologyAdapter final : public TopologyActions {
   // changed under a crack in a way it could not follow.
   std::uint32_t gaps() const { return gaps_; }
   double removed_mass_g() const { return removed_mass_g_; }
-  std::uint64_t stalks_cut() const { return stalks_cut_; }  // attachments the guillotine severed
+  // Stalks (attachments between two layers) the instruments severed: the guillotine within its
+  // reach, the scissors' jaws and the blades' edges wherever they swept while cutting.
+  std::uint64_t stalks_cut() const { return stalks_cut_; }
   const Status& last_error() const { return last_error_; }
 
  private:
   void note(const CutResult& r);
+  void sever_stalks_swept(TissueWorld& world, const CuttingPose& pose);
   // What one instrument cuts one surface with.
   struct Edges {
     Incision blade;
@@ -52,6 +56,12 @@ class TopologyAdapter final : public TopologyActions {
   std::vector<std::unique_ptr<Cutter>> cutters_;
   std::vector<std::unique_ptr<Edges>> edges_;  // [instrument × cutters_.size() + surface]
   std::vector<std::unique_ptr<Vitrector>> vitrectors_;
+  // Each instrument's cutting pose at the last step, for the area its edges swept since.
+  struct LastPose {
+    CuttingPose pose;
+    bool valid = false;
+  };
+  std::array<LastPose, kMaxInstruments> last_pose_{};
   std::uint32_t springs_opened_ = 0, gaps_ = 0;
   double removed_mass_g_ = 0.0;
   std::uint64_t stalks_cut_ = 0;

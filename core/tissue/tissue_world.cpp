@@ -212,20 +212,10 @@ std::uint32_t TissueWorld::cut_attachments_in(const Vec3& center_mm, const Vec3&
   const double n2 = normal.squaredNorm();
   if (!(n2 > 0.0) || !std::isfinite(n2) || !center_mm.allFinite() || !(radius_mm > 0.0)) return 0;
   const Vec3 n = normal / std::sqrt(n2);
-  std::uint32_t severed = 0;
-  for (Attachment& at : attachments_) {
-    if (!at.intact || at.cut || !(at.d.rest_length_mm > 0.0)) continue;
-    Surface& sa = *surfaces_[at.d.surface_a];
-    Surface& sb = *surfaces_[at.d.surface_b];
-    if (!sa.is_current(at.a) || !sb.is_current(at.b)) continue;
-    const Vec3 mid = 0.5 * (sa.position(at.a.index) + sb.position(at.b.index)) - center_mm;
-    if (mid.dot(n) < 0.0 || mid.squaredNorm() > radius_mm * radius_mm) continue;
-    at.cut = true;
-    sa.wake_vertex(at.a.index);
-    sb.wake_vertex(at.b.index);
-    ++severed;
-  }
-  return severed;
+  return cut_attachments_if([&](const Vec3& top, const Vec3& base) {
+    const Vec3 mid = 0.5 * (top + base) - center_mm;
+    return mid.dot(n) >= 0.0 && mid.squaredNorm() <= radius_mm * radius_mm;
+  });
 }
 
 bool TissueWorld::attachment_holds(std::uint32_t i) const {

@@ -264,11 +264,17 @@ class TissueWorld {
   bool attachment_intact(std::uint32_t i) const { return attachments_.at(i).intact; }
   // Intact and both ends still exist (a removed or cut-away end is only marked broken at the next step).
   bool attachment_holds(std::uint32_t i) const;
-  // Severs every intact stalk (an attachment with a rest length, both ends on surfaces) whose
-  // midpoint lies in the hemisphere of `radius_mm` about `center_mm` on the side `normal` points to
-  // — what a vitrector's cut reaches in front of its port. The attachments break at the next step
-  // boundary, reported like any broken attachment (magnitude: the force they last carried), and
-  // their ends are woken. Returns how many it severed.
+  // Severs every intact stalk (an attachment with a rest length, both ends on surfaces) for which
+  // `severs(top, base)` is true — given the strand's two ends, surface_a's (the elevated layer's)
+  // and surface_b's — the one mechanism by which any instrument cuts a bridge between two layers:
+  // the guillotine's reach, the scissors' closing jaws, a blade's sweep (core/instruments
+  // topology_adapter.cpp). The attachments break at the next step boundary, reported like any
+  // broken attachment (magnitude: the force they last carried), and their ends are woken. Returns
+  // how many it severed. A coincident attachment (rest length 0) goes only with its tissue.
+  template <class Severs>
+  std::uint32_t cut_attachments_if(Severs&& severs);
+  // cut_attachments_if for the stalks whose midpoint lies in the hemisphere of `radius_mm` about
+  // `center_mm` on the side `normal` points to — what a vitrector's cut reaches in front of its port.
   std::uint32_t cut_attachments_in(const Vec3& center_mm, const Vec3& normal, double radius_mm);
   // Force the attachment carried during the last step (µN): the constraint multiplier over h².
   double attachment_force(std::uint32_t i) const { return attachments_.at(i).last_force_un; }
@@ -306,7 +312,7 @@ class TissueWorld {
     AttachmentDescription d;
     VertexId a, b;
     bool intact = true;
-    bool cut = false;  // severed by an instrument since the last step boundary (cut_attachments_in)
+    bool cut = false;  // severed by an instrument since the last step boundary (cut_attachments_if)
     double last_force_un = 0.0;
     double peak_force_un = 0.0;
   };
@@ -496,6 +502,23 @@ class TissueWorld {
 template <class F>
 void TissueWorld::for_each_active_edge(std::uint32_t si, F&& f) {
   scratch_[si].groups.for_each_active(f);
+}
+
+template <class Severs>
+std::uint32_t TissueWorld::cut_attachments_if(Severs&& severs) {
+  std::uint32_t severed = 0;
+  for (Attachment& at : attachments_) {
+    if (!at.intact || at.cut || !(at.d.rest_length_mm > 0.0)) continue;
+    Surface& sa = *surfaces_[at.d.surface_a];
+    Surface& sb = *surfaces_[at.d.surface_b];
+    if (!sa.is_current(at.a) || !sb.is_current(at.b)) continue;
+    if (!severs(sa.position(at.a.index), sb.position(at.b.index))) continue;
+    at.cut = true;
+    sa.wake_vertex(at.a.index);
+    sb.wake_vertex(at.b.index);
+    ++severed;
+  }
+  return severed;
 }
 
 }  // namespace vitreo::core

@@ -1098,3 +1098,101 @@ TEST(Instruments, TheVitrectorsGuillotineSeversTheStalksInItsReach) {
   EXPECT_TRUE(world.attachment_holds(stalks[2]));
   EXPECT_EQ(world.surface(upper).triangle_count(), 1u) << "the upper layer was out of the port's reach";
 }
+
+namespace {
+
+// Two fixed 1 mm triangles 0.5 mm apart (inward +z), the upper held over the lower by a stalk at
+// each corner: (0,0), (1,0), (0,1).
+struct StalkedLayers {
+  TissueWorld world{GlobeWall::sphere(Vec3(0, 0, 100), 101), no_pressure(), no_sleep()};
+  std::vector<std::uint32_t> stalks;
+  StalkedLayers() {
+    SurfaceDescription d;
+    d.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    d.mesh.triangles = {{0, 1, 2}};
+    d.contained_by_globe = false;
+    const std::uint32_t lower = world.add_surface(d);
+    for (auto& p : d.mesh.positions) p.z() = 0.5;
+    const std::uint32_t upper = world.add_surface(d);
+    for (std::uint32_t v = 0; v < 3; ++v) {
+      EXPECT_TRUE(world.surface(lower).set_fixed(world.surface(lower).vertex_id(v), true));
+      EXPECT_TRUE(world.surface(upper).set_fixed(world.surface(upper).vertex_id(v), true));
+      AttachmentDescription a;
+      a.surface_a = upper;
+      a.vertex_a = v;
+      a.surface_b = lower;
+      a.vertex_b = v;
+      a.stiffness_un_per_mm = 1000.0;
+      a.rest_length_mm = 0.5;
+      stalks.push_back(world.add_attachment(a));
+    }
+  }
+  std::vector<bool> holding() const {
+    std::vector<bool> h;
+    for (auto s : stalks) h.push_back(world.attachment_holds(s));
+    return h;
+  }
+};
+
+CuttingPose scissors_between_the_layers(double opening_deg, double x = -0.5) {
+  // Horizontal scissors 0.25 mm up, the jaws 1 mm long pointing along +x from a hinge at (x, 0.05):
+  // the stalk at (0,0) lies 6° off the bisector, 0.5 mm out (in the mouth); (1,0) is beyond the jaws'
+  // reach and (0,1) 62° off, outside the mouth.
+  CuttingPose p;
+  p.instrument = 0;
+  p.kind = InstrumentKind::kScissors;
+  p.hinge = Vec3(x, 0.05, 0.25);
+  p.bisector = Vec3::UnitX();
+  p.normal = Vec3::UnitZ();
+  p.opening_rad = opening_deg * std::numbers::pi / 180.0;
+  p.jaw_length_mm = 1.0;
+  return p;
+}
+
+}  // namespace
+
+TEST(Instruments, ClosingScissorsSeverTheStalksBetweenTheirJaws) {
+  // Delamination with horizontal scissors: slid open between the layers, nothing is cut; opened
+  // further or moved, nothing; closing, the jaws sweep across the one stalk in their mouth and
+  // sever it (checked against where the stalks stand, not the adapter's bookkeeping).
+  StalkedLayers layers;
+  TopologyAdapter topology(layers.world, {}, {});
+  for (double x : {-1.5, -1.0, -0.5}) topology.cut(layers.world, scissors_between_the_layers(40.0, x));  // slid in, open
+  topology.cut(layers.world, scissors_between_the_layers(50.0));                                           // opened further
+  ASSERT_TRUE(layers.world.step(1e-3).ok);
+  EXPECT_EQ(layers.holding(), (std::vector<bool>{true, true, true})) << "open scissors moved in cut nothing";
+  EXPECT_EQ(topology.stalks_cut(), 0u);
+
+  for (double deg = 45.0; deg >= 0.0; deg -= 5.0) topology.cut(layers.world, scissors_between_the_layers(deg));
+  const StepReport step = layers.world.step(1e-3);
+  ASSERT_TRUE(step.ok);
+  EXPECT_EQ(step.attachments_broken, 1u);
+  EXPECT_EQ(topology.stalks_cut(), 1u);
+  EXPECT_EQ(layers.holding(), (std::vector<bool>{false, true, true})) << "only the stalk in the mouth";
+}
+
+TEST(Instruments, ClosedScissorsMovedThroughAStalkDoNotCutIt) {
+  // Scissors cut only as they close: closed jaws pushed past a stalk (from x = -1.5 to +0.5, their
+  // length sweeping over (0,0) and (1,0)) sever nothing.
+  StalkedLayers layers;
+  TopologyAdapter topology(layers.world, {}, {});
+  for (double x = -1.5; x <= 0.5; x += 0.25) topology.cut(layers.world, scissors_between_the_layers(0.0, x));
+  ASSERT_TRUE(layers.world.step(1e-3).ok);
+  EXPECT_EQ(layers.holding(), (std::vector<bool>{true, true, true}));
+}
+
+TEST(Instruments, ABladeSweptAcrossAStalkSeversIt) {
+  // A blade's edge 0.25 mm up along y from -0.5 to 0.5, swept along +x from 0.8 to 1.2: it crosses
+  // the stalk at (1,0) and no other.
+  StalkedLayers layers;
+  TopologyAdapter topology(layers.world, {}, {});
+  for (double x = 0.8; x <= 1.2 + 1e-9; x += 0.1) {
+    CuttingPose p;
+    p.kind = InstrumentKind::kBlade;
+    p.a = Vec3(x, -0.5, 0.25);
+    p.b = Vec3(x, 0.5, 0.25);
+    topology.cut(layers.world, p);
+  }
+  ASSERT_TRUE(layers.world.step(1e-3).ok);
+  EXPECT_EQ(layers.holding(), (std::vector<bool>{true, false, true}));
+}
