@@ -281,6 +281,8 @@ class TissueWorld {
   double attachment_break_force(std::uint32_t i) const { return attachments_.at(i).d.break_force_un; }
   // The slot of the attachment's first end (surface_a's vertex) now (cuts move vertices to new slots).
   std::uint32_t attachment_vertex_a(std::uint32_t i) const { return attachments_.at(i).a.index; }
+  // The slot of its second end (surface_b's vertex; unused when surface_b is kWorld).
+  std::uint32_t attachment_vertex_b(std::uint32_t i) const { return attachments_.at(i).b.index; }
   // Events of the last step (valid until the next step).
   const std::vector<TissueEvent>& events() const { return events_; }
   std::uint64_t step_count() const { return step_count_; }
