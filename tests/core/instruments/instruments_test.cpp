@@ -1046,74 +1046,22 @@ TEST(Simulation, TheObserverRunsLastOncePerStep) {
   EXPECT_EQ(recorder.grasps[20], 1u);
 }
 
-TEST(Instruments, TheVitrectorsGuillotineSeversTheStalksInItsReach) {
-  // Delamination: a layer held 0.5 mm over a fixed one by three stalks (triangles 1 mm on a side).
-  // A port 0.1 mm beside corner 0's stalk, facing it, low enough that the upper layer is out of the
-  // removal hemisphere: with the cutter off nothing happens; cutting, that stalk is severed — and
-  // only it — and nothing of the upper layer is removed.
-  TissueWorld world(GlobeWall::sphere(Vec3(0, 0, 100), 101), no_pressure(), no_sleep());  // inward: +z
-  SurfaceDescription d;
-  d.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  d.mesh.triangles = {{0, 1, 2}};
-  d.contained_by_globe = false;
-  const std::uint32_t lower = world.add_surface(d);
-  for (auto& p : d.mesh.positions) p.z() = 0.5;
-  const std::uint32_t upper = world.add_surface(d);
-  for (std::uint32_t v = 0; v < 3; ++v) {
-    ASSERT_TRUE(world.surface(lower).set_fixed(world.surface(lower).vertex_id(v), true));
-    ASSERT_TRUE(world.surface(upper).set_fixed(world.surface(upper).vertex_id(v), true));
-  }
-  std::vector<std::uint32_t> stalks;
-  for (std::uint32_t v = 0; v < 3; ++v) {
-    AttachmentDescription a;
-    a.surface_a = upper;
-    a.vertex_a = v;
-    a.surface_b = lower;
-    a.vertex_b = v;
-    a.stiffness_un_per_mm = 1000.0;
-    a.rest_length_mm = 0.5;
-    stalks.push_back(world.add_attachment(a));
-  }
-  TopologyAdapter topology(world, {}, {upper});
-  RemovalRequest r;
-  r.port_center_mm = Vec3(-0.1, 0.0, 0.1);  // the stalk's midpoint (0, 0, 0.25) is 0.18 mm away
-  r.port_normal = Vec3::UnitX();
-  r.removal_radius_mm = 0.3;
-  r.vacuum = 0.0;
-  r.dt_s = 0.02;  // at 7500 cuts/min the guillotine cuts every 8 ms
-
-  r.cut_rate_cpm = 0.0;
-  topology.remove(world, r);
-  ASSERT_TRUE(world.step(1e-3).ok);
-  for (auto s : stalks) EXPECT_TRUE(world.attachment_holds(s)) << "the cutter is off";
-
-  r.cut_rate_cpm = 7500.0;
-  topology.remove(world, r);
-  const StepReport step = world.step(1e-3);
-  ASSERT_TRUE(step.ok);
-  EXPECT_EQ(step.attachments_broken, 1u);
-  EXPECT_EQ(topology.stalks_cut(), 1u);
-  EXPECT_FALSE(world.attachment_holds(stalks[0]));
-  EXPECT_TRUE(world.attachment_holds(stalks[1]));
-  EXPECT_TRUE(world.attachment_holds(stalks[2]));
-  EXPECT_EQ(world.surface(upper).triangle_count(), 1u) << "the upper layer was out of the port's reach";
-}
-
 namespace {
 
 // Two fixed 1 mm triangles 0.5 mm apart (inward +z), the upper held over the lower by a stalk at
 // each corner: (0,0), (1,0), (0,1).
 struct StalkedLayers {
   TissueWorld world{GlobeWall::sphere(Vec3(0, 0, 100), 101), no_pressure(), no_sleep()};
+  std::uint32_t lower = 0, upper = 0;
   std::vector<std::uint32_t> stalks;
   StalkedLayers() {
     SurfaceDescription d;
     d.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     d.mesh.triangles = {{0, 1, 2}};
     d.contained_by_globe = false;
-    const std::uint32_t lower = world.add_surface(d);
+    lower = world.add_surface(d);
     for (auto& p : d.mesh.positions) p.z() = 0.5;
-    const std::uint32_t upper = world.add_surface(d);
+    upper = world.add_surface(d);
     for (std::uint32_t v = 0; v < 3; ++v) {
       EXPECT_TRUE(world.surface(lower).set_fixed(world.surface(lower).vertex_id(v), true));
       EXPECT_TRUE(world.surface(upper).set_fixed(world.surface(upper).vertex_id(v), true));
@@ -1150,6 +1098,40 @@ CuttingPose scissors_between_the_layers(double opening_deg, double x = -0.5) {
 }
 
 }  // namespace
+
+TEST(Instruments, TheVitrectorsGuillotineSeversTheStalksInItsReach) {
+  // Delamination: a layer held 0.5 mm over a fixed one by three stalks (triangles 1 mm on a side).
+  // A port 0.1 mm beside corner 0's stalk, facing it, low enough that the upper layer is out of the
+  // removal hemisphere: with the cutter off nothing happens; cutting, that stalk is severed — and
+  // only it — and nothing of the upper layer is removed.
+  StalkedLayers layers;
+  TissueWorld& world = layers.world;
+  const std::uint32_t upper = layers.upper;
+  const std::vector<std::uint32_t>& stalks = layers.stalks;
+  TopologyAdapter topology(world, {}, {upper});
+  RemovalRequest r;
+  r.port_center_mm = Vec3(-0.1, 0.0, 0.1);  // the stalk's midpoint (0, 0, 0.25) is 0.18 mm away
+  r.port_normal = Vec3::UnitX();
+  r.removal_radius_mm = 0.3;
+  r.vacuum = 0.0;
+  r.dt_s = 0.02;  // at 7500 cuts/min the guillotine cuts every 8 ms
+
+  r.cut_rate_cpm = 0.0;
+  topology.remove(world, r);
+  ASSERT_TRUE(world.step(1e-3).ok);
+  for (auto s : stalks) EXPECT_TRUE(world.attachment_holds(s)) << "the cutter is off";
+
+  r.cut_rate_cpm = 7500.0;
+  topology.remove(world, r);
+  const StepReport step = world.step(1e-3);
+  ASSERT_TRUE(step.ok);
+  EXPECT_EQ(step.attachments_broken, 1u);
+  EXPECT_EQ(topology.stalks_cut(), 1u);
+  EXPECT_FALSE(world.attachment_holds(stalks[0]));
+  EXPECT_TRUE(world.attachment_holds(stalks[1]));
+  EXPECT_TRUE(world.attachment_holds(stalks[2]));
+  EXPECT_EQ(world.surface(upper).triangle_count(), 1u) << "the upper layer was out of the port's reach";
+}
 
 TEST(Instruments, ClosingScissorsSeverTheStalksBetweenTheirJaws) {
   // Delamination with horizontal scissors: slid open between the layers, nothing is cut; opened
