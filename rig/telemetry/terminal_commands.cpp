@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdarg>
 #include <chrono>
 #include <string>
 
@@ -15,6 +16,15 @@ namespace vitreo::telemetry {
 TerminalCommands::TerminalCommands(int fd, CommandServer& server, std::FILE* out) : fd_(fd), server_(server), out_(out) {}
 
 TerminalCommands::~TerminalCommands() { stop(); }
+
+void TerminalCommands::say(const char* format, ...) {
+  if (out_ == nullptr) return;  // a session with nowhere to print its acks still runs the commands
+  va_list args;
+  va_start(args, format);
+  std::vfprintf(out_, format, args);
+  va_end(args);
+  std::fflush(out_);
+}
 
 void TerminalCommands::start() {
   if (running_.exchange(true)) return;
@@ -65,8 +75,7 @@ void TerminalCommands::run() {
     if (pending.size() > kMaxLine) {  // no newline in sight: refuse it rather than grow without bound
       ++lines_;
       ++refused_;
-      std::fprintf(out_, "> line longer than %zu characters: ignored\n", kMaxLine);
-      std::fflush(out_);
+      say("> line longer than %zu characters: ignored\n", kMaxLine);
       pending.clear();
       overlong = true;
     }
@@ -78,8 +87,7 @@ void TerminalCommands::handle_line(const std::string& line) {
   const ParsedCommand parsed = parse_command_line(line, "terminal", ++seq_);
   if (!parsed.ok) {
     ++refused_;
-    std::fprintf(out_, "> %s\n", parsed.error.c_str());
-    std::fflush(out_);
+    say("> %s\n", parsed.error.c_str());
     return;
   }
   LocalCommand cmd;
@@ -91,8 +99,7 @@ void TerminalCommands::handle_line(const std::string& line) {
   const char* name = command_name(cmd.command);
   if (!server_.submit(cmd)) {
     ++refused_;
-    std::fprintf(out_, "> %s: refused: too many commands waiting\n", name);
-    std::fflush(out_);
+    say("> %s: refused: too many commands waiting\n", name);
     return;
   }
   // The telemetry thread answers within a few milliseconds; give it two seconds (a loaded machine).
@@ -108,17 +115,16 @@ void TerminalCommands::handle_line(const std::string& line) {
   }
   if (!got) {
     ++refused_;
-    std::fprintf(out_, "> %s: no answer from the rig\n", name);
+    say("> %s: no answer from the rig\n", name);
   } else if (ack.accepted) {
     ++accepted_;
     const std::string_view reason = text(ack.reason);
-    std::fprintf(out_, "> %s: accepted%s%.*s\n", name, reason.empty() ? "" : " ", static_cast<int>(reason.size()), reason.data());
+    say("> %s: accepted%s%.*s\n", name, reason.empty() ? "" : " ", static_cast<int>(reason.size()), reason.data());
   } else {
     ++refused_;
     const std::string_view reason = text(ack.reason);
-    std::fprintf(out_, "> %s: refused: %.*s\n", name, static_cast<int>(reason.size()), reason.data());
+    say("> %s: refused: %.*s\n", name, static_cast<int>(reason.size()), reason.data());
   }
-  std::fflush(out_);
 }
 
 }  // namespace vitreo::telemetry

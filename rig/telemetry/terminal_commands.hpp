@@ -20,7 +20,8 @@ namespace vitreo::telemetry {
 class TerminalCommands {
  public:
   static constexpr std::size_t kMaxLine = 1024;  // longer lines are refused, not buffered
-  // Does not take ownership of `fd`. `out`: where acks are printed.
+  // Does not take ownership of `fd`. `out`: where acks are printed (nullptr: nowhere; the commands
+  // still run and are counted).
   TerminalCommands(int fd, CommandServer& server, std::FILE* out = stdout);
   ~TerminalCommands();
   TerminalCommands(const TerminalCommands&) = delete;
@@ -36,6 +37,7 @@ class TerminalCommands {
  private:
   void run();
   void handle_line(const std::string& line);
+  void say(const char* format, ...) __attribute__((format(printf, 2, 3)));  // to out_, flushed; no-op without one
 
   int fd_;
   CommandServer& server_;

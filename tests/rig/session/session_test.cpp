@@ -664,6 +664,26 @@ TEST(RigSession, PipedCommandsAreDecidedInOrderAndTheLastLineCountsWithoutItsNew
   std::filesystem::remove(config.record_path);
 }
 
+// A session given commands but nowhere to print their acknowledgements (command_echo = nullptr: a
+// scripted run, a service with no console) still decides and applies them; it used to crash writing
+// the first acknowledgement to a null stream.
+TEST(RigSession, CommandsWithNowhereToPrintTheirAcksStillApply) {
+  auto config = small_session("silent", 1500);
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string typed = "laser_power 400\nz 99\nlaser_duration 300\n";
+  ASSERT_EQ(::write(fds[1], typed.data(), typed.size()), static_cast<ssize_t>(typed.size()));
+  ::close(fds[1]);
+  config.command_fd = fds[0];
+  config.command_echo = nullptr;
+  const rig::SessionSummary live = rig::run_session(config);
+  ::close(fds[0]);
+  EXPECT_EQ(live.steps, 1500u);
+  EXPECT_EQ(live.laser_at_end.power_mw, 400.0);
+  EXPECT_EQ(live.laser_at_end.duration_ms, 300.0) << "the command after a refused one applies too";
+  std::filesystem::remove(config.record_path);
+}
+
 TEST(RigSession, TerminalCommandsSwitchCasesResetAndSaveSnapshotsAndReplayReproducesThem) {
   auto config = small_session("commands", 6000);
   config.model = small_model({kScenes + "/exercise_pull_tissue.toml", kScenes + "/exercise_cut_path.toml"});
