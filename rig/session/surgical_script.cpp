@@ -545,8 +545,10 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     auto it = out.device_scripts.find(f.device);
     if (it == out.device_scripts.end())
       throw std::runtime_error(script.file + ":" + std::to_string(f.line) + ": fault.device: " + f.device + " is not played by this script");
+    // The emulator's line (drivers/sim): only a clock jump takes a value, its size in ms.
     char buf[128];
-    std::snprintf(buf, sizeof buf, "fault %.1f %.1f %s %g\n", f.at_s * 1e3, f.duration_s * 1e3, f.kind.c_str(), f.value);
+    if (f.kind == "jump") std::snprintf(buf, sizeof buf, "fault %.1f %.1f jump %g\n", f.at_s * 1e3, f.duration_s * 1e3, f.value);
+    else std::snprintf(buf, sizeof buf, "fault %.1f %.1f %s\n", f.at_s * 1e3, f.duration_s * 1e3, f.kind.c_str());
     it->second += buf;
   }
   return out;

@@ -117,6 +117,31 @@ TEST_F(Resolving, AStandoffPutsTheTipOnThePortLineShortOfItsPoint) {
   EXPECT_NE(error_of(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"fovea\"\nstandoff_mm = -1.0\n").find("standoff_mm"), std::string::npos);
 }
 
+// Every fault kind a script names reaches its device's emulator as a line the emulator accepts,
+// with its time, duration and (a clock jump only) size. Before, every kind but `jump` was written
+// with a value the emulator refuses, and the device never started.
+TEST_F(Resolving, EveryFaultKindReachesItsEmulator) {
+  const char* kinds[] = {"nan", "range", "stuck", "jump", "version", "unknown", "drop", "disconnect"};
+  std::string text = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\n";
+  for (int i = 0; i < 8; ++i) {
+    text += "[[fault]]\ndevice = \"" + std::string(i % 2 ? "pedals" : "tracker-0") + "\"\nkind = \"" + kinds[i] + "\"\nat_s = " +
+            std::to_string(1 + i) + "\nduration_s = 0.25\n" + (std::string(kinds[i]) == "jump" ? "value = 40.0\n" : "");
+  }
+  const ResolvedScript r = resolve_script(parse_surgical_script(text, "f.toml"), *case_, PedalMapping{});
+  for (const char* device : {"tracker-0", "pedals"}) {
+    drivers::sim::Script s;
+    std::string err;
+    ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at(device), s, &err)) << device << ": " << err;
+    ASSERT_EQ(s.faults.size(), 4u) << device;
+    for (const auto& f : s.faults) {
+      const int i = static_cast<int>(f.at_us / 1'000'000) - 1;
+      EXPECT_EQ(f.at_us, static_cast<std::uint64_t>(1 + i) * 1'000'000u);
+      EXPECT_EQ(f.duration_us, 250'000u);
+      EXPECT_EQ(f.value, std::string(kinds[i]) == "jump" ? 40.0 : 0.0);
+    }
+  }
+}
+
 TEST_F(Resolving, ACaseCanPutTheWorkingHandThroughTheOtherPort) {
   // instruments.working_port = "working_2": the tool's tracker pivots about the port the light pipe
   // used, the light pipe's about the other, telemetry names the eye's ports, and a script's "port"
