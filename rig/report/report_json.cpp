@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "core/metrics/score_card.hpp"
 #include "rig/report/json_writer.hpp"
@@ -215,6 +218,60 @@ void write_category_inputs(JsonWriter& j, const std::string& name, const TotalsR
 }
 
 // Every k-th sample so a series holds at most max_points (deterministic; the last one always kept).
+// device_status_t::STATE_* in words.
+const char* device_state_name(int state) {
+  switch (state) {
+    case 0: return "unconfigured";
+    case 1: return "inactive";
+    case 2: return "active";
+    case 3: return "error";
+    case 4: return "lost";
+    default: return "unknown";
+  }
+}
+
+// One line of what went wrong with a device ("" when nothing did): what an instructor reads before
+// trusting the score, and a technician before the next session.
+std::string device_fault_sentence(const DeviceRecord& d) {
+  std::vector<std::string> parts;
+  const auto count = [&](std::int64_t n, const char* what) {
+    if (n > 0) parts.push_back(std::to_string(n) + " " + what);
+  };
+  std::map<std::string, int> spells;
+  for (const auto& sp : d.spells) ++spells[sp.what];
+  for (const auto& [what, n] : spells) parts.push_back(what + " " + std::to_string(n) + (n == 1 ? " time" : " times"));
+  if (d.stuck_samples > 0) parts.push_back(std::to_string(d.stuck_samples) + " samples frozen while stuck");
+  const std::int64_t refused = d.crc_errors + d.framing_errors + d.version_rejected + d.unknown_type_rejected + d.length_rejected +
+                               d.range_rejected + d.identity_rejected + d.protocol_rejected;
+  if (refused > 0) {
+    std::string r = std::to_string(refused) + " frames refused (";
+    const std::pair<const char*, std::int64_t> causes[] = {{"CRC", d.crc_errors},          {"framing", d.framing_errors},
+                                                           {"version", d.version_rejected}, {"type", d.unknown_type_rejected},
+                                                           {"length", d.length_rejected},   {"out of range or NaN", d.range_rejected},
+                                                           {"identity", d.identity_rejected}, {"protocol", d.protocol_rejected}};
+    bool first = true;
+    for (const auto& [name, n] : causes) {
+      if (n == 0) continue;
+      r += (first ? "" : ", ") + std::string(name) + " " + std::to_string(n);
+      first = false;
+    }
+    parts.push_back(r + ")");
+  }
+  count(d.sequence_gaps, "frames missing from the sequence (lost on the way or refused)");
+  count(d.timestamp_jumps, "timestamp jumps");
+  count(d.heartbeat_misses, "heartbeat misses");
+  count(d.reconnects, "reconnects");
+  if (d.reader_stalls > 0) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "the reader stalled %lld times (longest %.0f ms; the host was busy, not the device)",
+                  static_cast<long long>(d.reader_stalls), d.reader_stall_max_ms);
+    parts.push_back(buf);
+  }
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? "; " : "") + parts[i];
+  return out;
+}
+
 std::vector<std::size_t> decimate(std::size_t n, std::size_t max_points) {
   std::vector<std::size_t> idx;
   if (n == 0) return idx;
@@ -250,6 +307,11 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     notices.push_back("no final score in the log: the session did not end normally; the numbers are the last running ones, at step " +
                       std::to_string(score->step));
   if (!survey_problem.empty()) notices.push_back("survey.json not shown: " + survey_problem);
+  for (const auto& d : log.devices) {
+    // A device that was lost, stuck, stale or refused during the session: the score was made with
+    // that instrument, pedal or fixture not (or not truly) following the hand.
+    if (!d.spells.empty()) notices.push_back(d.name + " during the session: " + device_fault_sentence(d));
+  }
   if (totals && totals->formula_version != core::kScoreFormulaVersion)
     notices.push_back("the session scored with formulas version " + std::to_string(totals->formula_version) + "; this report knows version " +
                       std::to_string(core::kScoreFormulaVersion) + " (the inputs' recomputation is not comparable)");
@@ -498,6 +560,52 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     j.key("tissue").value(e.tissue);
     j.key("position_mm").begin_array().value(e.position_mm[0]).value(e.position_mm[1]).value(e.position_mm[2]).end_array();
     j.field("magnitude", e.magnitude, event_unit(e));
+    j.end_object();
+  }
+  j.end_array();
+
+  // The devices: link and sensor faults, as the rig reported them (device_status_t), so the
+  // instructor sees when a score was made on a stuck or lost tracker, and the technician what failed.
+  j.key("devices").begin_array();
+  for (const auto& d : log.devices) {
+    j.begin_object();
+    j.key("device_id").value(d.device_id);
+    j.key("name").value(d.name);
+    j.key("transport").value(d.transport);
+    j.key("state").value(device_state_name(d.state));
+    j.key("detail").value(d.detail);
+    j.key("status_messages").value(static_cast<std::int64_t>(d.status_messages));
+    j.key("frames_rx").value(d.frames_rx);
+    j.key("refused").begin_object();
+    j.key("crc").value(d.crc_errors);
+    j.key("framing").value(d.framing_errors);
+    j.key("version").value(d.version_rejected);
+    j.key("unknown_type").value(d.unknown_type_rejected);
+    j.key("length").value(d.length_rejected);
+    j.key("range").value(d.range_rejected);
+    j.key("identity").value(d.identity_rejected);
+    j.key("protocol").value(d.protocol_rejected);
+    j.end_object();
+    j.key("sequence_gaps").value(d.sequence_gaps);
+    j.key("heartbeat_misses").value(d.heartbeat_misses);
+    j.key("reconnects").value(d.reconnects);
+    j.key("stuck_episodes").value(d.stuck_episodes);
+    j.key("stuck_samples").value(d.stuck_samples);
+    j.key("timestamp_jumps").value(d.timestamp_jumps);
+    j.key("reader_stalls").value(d.reader_stalls);
+    j.field("reader_stall_max", d.reader_stall_max_ms, "ms");
+    j.key("spells").begin_array();
+    for (const auto& sp : d.spells) {
+      j.begin_object();
+      j.key("what").value(sp.what);
+      j.field("from", sp.from_s, "s");
+      if (sp.to_s >= 0) j.field("to", sp.to_s, "s");
+      else j.key("to").value(nullptr);  // still so at the end of the log
+      j.key("detail").value(sp.detail);
+      j.end_object();
+    }
+    j.end_array();
+    j.key("faults").value(device_fault_sentence(d));
     j.end_object();
   }
   j.end_array();

@@ -1,5 +1,7 @@
 #include "rig/report/session_log.hpp"
 
+#include <algorithm>
+#include <iterator>
 #include <stdexcept>
 
 #include "rig/telemetry/channels.hpp"
@@ -8,6 +10,7 @@
 #include "rig/telemetry/lcm_subscribe.hpp"
 #include "vitreo_lcm/controls_t.hpp"
 #include "vitreo_lcm/criteria_t.hpp"
+#include "vitreo_lcm/device_status_t.hpp"
 #include "vitreo_lcm/event_t.hpp"
 #include "vitreo_lcm/instrument_state_t.hpp"
 #include "vitreo_lcm/score_t.hpp"
@@ -23,6 +26,56 @@ using telemetry::decode_message;
 template <class Msg>
 bool decode(const telemetry::LcmLogEvent& ev, Msg& m) {
   return decode_message(ev.data.data(), ev.data.size(), m, telemetry::kDefaultMaxMessageBytes) == DecodeError::None;
+}
+
+// What a status says is wrong with its device now ("" when nothing): the spell it belongs to.
+std::string spell_of(const vitreo_lcm::device_status_t& m) {
+  using S = vitreo_lcm::device_status_t;
+  if (m.state == S::STATE_LOST) return "lost";
+  if (m.state == S::STATE_ERROR) return "refused";
+  if (m.stuck) return "stuck";
+  if (m.state == S::STATE_ACTIVE && m.detail.rfind("stale", 0) == 0) return "stale";
+  return "";
+}
+
+void take_device_status(const vitreo_lcm::device_status_t& m, SessionLog& log) {
+  auto it = std::find_if(log.devices.begin(), log.devices.end(), [&](const DeviceRecord& d) { return d.device_id == m.device_id; });
+  if (it == log.devices.end()) {
+    log.devices.emplace_back();
+    it = std::prev(log.devices.end());
+    it->device_id = m.device_id;
+  }
+  DeviceRecord& d = *it;
+  ++d.status_messages;
+  d.name = m.name;
+  d.transport = m.transport;
+  d.state = m.state;
+  d.detail = m.detail;
+  d.frames_rx = m.frames_rx;
+  d.crc_errors = m.crc_errors;
+  d.framing_errors = m.framing_errors;
+  d.version_rejected = m.version_rejected;
+  d.unknown_type_rejected = m.unknown_type_rejected;
+  d.length_rejected = m.length_rejected;
+  d.range_rejected = m.range_rejected;
+  d.identity_rejected = m.identity_rejected;
+  d.protocol_rejected = m.protocol_rejected;
+  d.sequence_gaps = m.sequence_gaps;
+  d.heartbeat_misses = m.heartbeat_misses;
+  d.reconnects = m.reconnects;
+  d.stuck_episodes = m.stuck_episodes;
+  d.stuck_samples = m.stuck_samples;
+  d.timestamp_jumps = m.timestamp_jumps;
+  d.reader_stalls = m.reader_stalls;
+  d.reader_stall_max_ms = m.reader_stall_max_ms;
+  // A spell ends when a status no longer says it, and begins when one first does.
+  const std::string now = spell_of(m);
+  DeviceSpell* open = !d.spells.empty() && d.spells.back().to_s < 0 ? &d.spells.back() : nullptr;
+  if (open && open->what != now) {
+    open->to_s = log.latest_t_s;
+    open = nullptr;
+  }
+  if (!open && !now.empty()) d.spells.push_back({now, log.latest_t_s, -1, m.detail});
 }
 
 // Records one decoded event; false when its bytes did not decode as its channel's type.
@@ -42,6 +95,7 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     s.actuation = m.actuation;
     s.retina_force_un = m.retina_force_un;
     s.frozen = m.frozen;
+    log.latest_t_s = std::max(log.latest_t_s, s.t_s);
     log.tips.push_back(std::move(s));
   } else if (ev.channel == t::kChanEvent) {
     vitreo_lcm::event_t m{};
@@ -123,9 +177,14 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     c.zoom = m.zoom;
     c.reflux = m.reflux;
     c.laser_fire = m.laser_fire;
+    log.latest_t_s = std::max(log.latest_t_s, c.t_s);
     log.controls.push_back(c);
+  } else if (ev.channel == t::kChanDeviceStatus) {
+    vitreo_lcm::device_status_t m{};
+    if (!decode(ev, m)) return false;
+    take_device_status(m, log);
   }
-  return true;  // other channels (device status, timing, acks) are not part of the debrief
+  return true;  // other channels (timing, acks, frames) are not part of the debrief
 }
 
 }  // namespace

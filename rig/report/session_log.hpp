@@ -90,6 +90,33 @@ struct ControlsRecord {
   bool reflux = false, laser_fire = false;
 };
 
+// A spell in which a device was not simply working: "lost" (link gone), "stuck" (bit-identical
+// samples for 50 ms or more of device time; a tracker's instrument frozen), "stale" (no sample for a
+// while), "refused" (ERROR: another device, serial or protocol version than the rig file's). Times are
+// the session's (the newest step time the log had published before the status), to the status
+// messages' 10 Hz.
+struct DeviceSpell {
+  std::string what;
+  double from_s = 0;
+  double to_s = -1;  // < 0: it lasted to the end of the log
+  std::string detail;  // the rig's words when it began
+};
+
+// One device's link and sensor record (VITREO_DEVICE_STATUS): the counters of its last status (they
+// are cumulative over the session) and its spells.
+struct DeviceRecord {
+  std::int32_t device_id = 0;
+  std::string name, transport;
+  int state = 0;  // device_status_t::STATE_* of the last status
+  std::string detail;
+  std::uint64_t status_messages = 0;
+  std::int64_t frames_rx = 0, crc_errors = 0, framing_errors = 0, version_rejected = 0, unknown_type_rejected = 0, length_rejected = 0,
+               range_rejected = 0, identity_rejected = 0, protocol_rejected = 0, sequence_gaps = 0, heartbeat_misses = 0, reconnects = 0,
+               stuck_episodes = 0, stuck_samples = 0, timestamp_jumps = 0, reader_stalls = 0;
+  double reader_stall_max_ms = 0;
+  std::vector<DeviceSpell> spells;
+};
+
 struct SessionLog {
   std::string path;
   std::uint64_t file_bytes = 0;
@@ -104,6 +131,8 @@ struct SessionLog {
   std::vector<CriteriaRecord> criteria;
   std::vector<TotalsRecord> totals;
   std::vector<ControlsRecord> controls;
+  std::vector<DeviceRecord> devices;  // in order of their first status
+  double latest_t_s = 0;              // while reading: the newest session time published so far
 };
 
 // Reads the whole log (see above for what is an error and what a notice).

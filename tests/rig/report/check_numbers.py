@@ -10,8 +10,9 @@ usage: check_numbers.py PYTHON_TYPES_DIR SESSION_DIR
 import json
 import math
 import re
-import struct
 import sys
+
+from lcm_log import read_log
 
 sys.path.insert(0, sys.argv[1])
 from vitreo_lcm import (criteria_t, event_t, instrument_state_t, score_t,  # noqa: E402
@@ -24,21 +25,6 @@ failures = []
 def check(what, ok, detail=""):
     if not ok:
         failures.append(f"{what}: {detail}")
-
-
-def read_log(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    at, out = 0, []
-    while at + 28 <= len(data):
-        sync, num, utime, clen, dlen = struct.unpack(">IqqII", data[at:at + 28])
-        assert sync == 0xEDA1DA01, f"no sync word at {at}"
-        chan = data[at + 28:at + 28 + clen].decode()
-        body = data[at + 28 + clen:at + 28 + clen + dlen]
-        out.append((chan, body))
-        at += 28 + clen + dlen
-    assert at == len(data), "the log does not end on an event boundary"
-    return out
 
 
 events = read_log(f"{session}/telemetry.lcmlog")
