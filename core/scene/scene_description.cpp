@@ -117,6 +117,7 @@ void SceneDescription::validate() const {
   anatomy.validate();
   if (texture_size_px < 64 || texture_size_px > 8192) throw InvalidArgument("texture_size_px must be in [64, 8192]");
   require_range(intraocular_pressure_mmhg, 0.0, 80.0, "intraocular_pressure_mmhg");
+  require_range(pass_score, 0.0, 100.0, "proficiency.pass_score");
   if (substeps < 1 || substeps > 64) throw InvalidArgument("substeps must be in [1, 64]");
   if (!(gel_adhesion_break_force_un > 0.0)) throw InvalidArgument("gel_adhesion_break_force_un must be > 0");
   if (gel_adhesion_stride < 1 || gel_adhesion_stride > 100) throw InvalidArgument("gel_adhesion_stride must be in [1, 100]");

@@ -157,6 +157,10 @@ struct SceneDescription {
   std::string working_port = "working_1";
   std::vector<GuideSpec> guides;
   std::vector<CriterionSpec> criteria;
+  // [proficiency] pass_score: the final score (0..100) an attempt must reach to pass this case. The
+  // instructor's standard for the case, published with every score card, so the debrief and a
+  // trainee's history say which attempts passed.
+  double pass_score = 70.0;
   SettleSpec settle;
   ViewSpec view;
   std::string source_file;  // where it was read from (diagnostics)

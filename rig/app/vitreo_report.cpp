@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <optional>
 
 #include "rig/report/trainee_history.hpp"
 #include "rig/report/write_report.hpp"
@@ -19,10 +20,10 @@ int main(int argc, char** argv) {
   std::string dir;
   vitreo::report::ReportOptions options;
   std::string trainee;
-  double pass_score = 70;
+  double pass_for_all = 0;
   app.add_option("DIR", dir, "session folder (what `vitreo --out DIR` wrote); with --trainee, the folder holding session folders")->required();
   app.add_option("--trainee", trainee, "write DIR/history-ID.html/.json: that trainee's sessions under DIR, per case, as a learning curve");
-  app.add_option("--pass", pass_score, "with --trainee: the score a final attempt must reach to pass (default 70)")->check(CLI::Range(0.0, 100.0));
+  auto* pass_opt = app.add_option("--pass", pass_for_all, "with --trainee: the score a final attempt must reach to pass, for every case (default: each case's own pass score)")->check(CLI::Range(0.0, 100.0));
   app.add_option("--log", options.telemetry_log, "telemetry log to read instead of DIR/telemetry.lcmlog");
   app.add_option("--out", options.out_dir, "folder to write report.json and report.html into (default: DIR)");
   app.add_option("--compare", options.compare_dir,
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (!trainee.empty()) {
+      // Unset: each case is judged against its own pass score ([proficiency] pass_score).
+      const std::optional<double> pass_score = *pass_opt ? std::optional<double>(pass_for_all) : std::nullopt;
       const auto h = vitreo::report::write_history(dir, trainee, pass_score, options.out_dir, options.generated.empty() ? "now" : options.generated);
       std::printf("history of %s: %d sessions in %d cases%s\n  %s\n  %s\n", trainee.c_str(), h.sessions, h.cases,
                   h.skipped ? (", " + std::to_string(h.skipped) + " unreadable reports left out").c_str() : "", h.json_path.c_str(),

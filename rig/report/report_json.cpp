@@ -344,6 +344,10 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
   j.field("session_length", last_t, "s");
   j.key("last_step").value(last_step);
   j.key("started_utime_us").value(log.first_utime_us);  // the log's first event (wall clock, µs since the epoch)
+  // The case's pass score (its file's [proficiency] pass_score) and whether this attempt passed: a
+  // final score at or above it.
+  if (score) j.field("pass_score", score->pass_score, "points (0..100)");
+  j.key("passed").value(score && score->final_score && score->total >= score->pass_score);
   // The physics period, from the samples' own time and step (1 ms when the log has none).
   j.field("step_period", last_step > 0 ? last_t / static_cast<double>(last_step) : 0.001, "s");
   j.end_object();

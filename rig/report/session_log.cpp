@@ -118,6 +118,7 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     s.case_id = m.case_id;
     s.final_score = m.final_score;
     s.total = m.total;
+    s.pass_score = m.pass_score;
     for (std::size_t i = 0; i < m.name.size() && i < m.value.size(); ++i) s.categories.emplace_back(m.name[i], m.value[i]);
     log.scores.push_back(std::move(s));
   } else if (ev.channel == t::kChanCriteria) {

@@ -43,6 +43,7 @@ struct ScoreRecord {
   std::string case_id;
   bool final_score = false;
   double total = 0;
+  double pass_score = 0;  // the case's ([proficiency] pass_score)
   std::vector<std::pair<std::string, double>> categories;
 };
 

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -28,6 +29,7 @@ struct Attempt {
   std::int64_t started_us = 0;
   double total = 0;
   bool final_score = false;
+  std::optional<double> pass_score;  // the case's, as its report carries it
   std::vector<std::pair<std::string, double>> categories;
 };
 
@@ -60,8 +62,8 @@ std::string read_trainee(const std::string& session_dir) {
   return valid_trainee_id(id) ? id : "";
 }
 
-HistoryFiles write_history(const std::string& root, const std::string& trainee, double pass_score, const std::string& out_dir,
-                           const std::string& generated) {
+HistoryFiles write_history(const std::string& root, const std::string& trainee, std::optional<double> pass_override,
+                           const std::string& out_dir, const std::string& generated) {
   if (!valid_trainee_id(trainee)) throw std::runtime_error("trainee id '" + trainee + "': 1-64 characters of A-Z a-z 0-9 . _ - please");
   std::error_code ec;
   if (!fs::is_directory(root, ec)) throw std::runtime_error("'" + root + "' is not a folder of sessions");
@@ -80,6 +82,7 @@ HistoryFiles write_history(const std::string& root, const std::string& trainee, 
       a.started_us = j.at("case").value("started_utime_us", std::int64_t{0});
       a.total = j.at("score").at("total").at("value").get<double>();
       a.final_score = j.at("score").at("final").get<bool>();
+      if (j.at("case").contains("pass_score")) a.pass_score = j.at("case").at("pass_score").at("value").get<double>();
       for (const auto& c : j.at("score").at("categories")) a.categories.emplace_back(c.at("name").get<std::string>(), c.at("value").at("value").get<double>());
       by_case[j.at("case").at("id").get<std::string>()].push_back(std::move(a));
       ++files.sessions;
@@ -93,7 +96,8 @@ HistoryFiles write_history(const std::string& root, const std::string& trainee, 
   JsonWriter j;
   j.begin_object();
   j.key("trainee").value(trainee);
-  j.field("pass_score", pass_score, "points (0..100)");
+  if (pass_override) j.field("pass_score", *pass_override, "points (0..100)");
+  else j.key("pass_score").value(nullptr);  // each case's own (below)
   j.key("sessions").value(files.sessions);
   j.key("skipped_folders").value(files.skipped);
   j.key("cases").begin_array();
@@ -101,8 +105,26 @@ HistoryFiles write_history(const std::string& root, const std::string& trainee, 
     std::stable_sort(attempts.begin(), attempts.end(), [](const Attempt& x, const Attempt& y) { return x.started_us < y.started_us; });
     double best = 0;
     int first_pass = 0;
+    // The case's pass score: the instructor's for all cases, else the newest report's (the case file
+    // as it was at that session), else the default for reports that carry none.
+    double pass_score = kDefaultPassScore;
+    const char* from = "default (the reports carry none)";
+    if (pass_override) {
+      pass_score = *pass_override;
+      from = "--pass";
+    } else {
+      for (auto it = attempts.rbegin(); it != attempts.rend(); ++it) {
+        if (it->pass_score) {
+          pass_score = *it->pass_score;
+          from = "case file";
+          break;
+        }
+      }
+    }
     j.begin_object();
     j.key("case").value(id);
+    j.field("pass_score", pass_score, "points (0..100)");
+    j.key("pass_score_from").value(from);
     j.key("attempts").begin_array();
     for (std::size_t i = 0; i < attempts.size(); ++i) {
       const Attempt& a = attempts[i];

@@ -3,6 +3,9 @@
 // the order the sessions started — the learning curve, against a pass score (EyeSi shows progress
 // the same way). Reads the report.json files the sessions' reports wrote (the main job writes one
 // at the end of every session; `vitreo --trainee ID` names the trainee, kept in DIR/trainee.txt).
+// Each case is judged against its own pass score (its file's [proficiency] pass_score, which every
+// report carries), unless the instructor gives one for all cases.
+#include <optional>
 #include <string>
 
 namespace vitreo::report {
@@ -19,9 +22,13 @@ struct HistoryFiles {
   int skipped = 0;  // folders with a report.json that could not be read
 };
 
-// Writes OUT/history-ID.json and OUT/history-ID.html. Throws std::runtime_error for an invalid id,
-// an unreadable ROOT, or no session of that trainee under it.
-HistoryFiles write_history(const std::string& root, const std::string& trainee, double pass_score, const std::string& out_dir,
-                           const std::string& generated);
+// The pass score of a report that carries none (written before cases had one).
+inline constexpr double kDefaultPassScore = 70.0;
+
+// Writes OUT/history-ID.json and OUT/history-ID.html. pass_override: one pass score for every case
+// instead of each case's own. Throws std::runtime_error for an invalid id, an unreadable ROOT, or no
+// session of that trainee under it.
+HistoryFiles write_history(const std::string& root, const std::string& trainee, std::optional<double> pass_override,
+                           const std::string& out_dir, const std::string& generated);
 
 }  // namespace vitreo::report

@@ -512,6 +512,16 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
       probe.validate();
     });
   }
+  if (auto t = root.table("proficiency")) {
+    t->number("pass_score", d.pass_score);
+    t->finish();
+    validated(*t, [&] {
+      core::SceneDescription probe;
+      probe.name = "probe";
+      probe.pass_score = d.pass_score;
+      probe.validate();
+    });
+  }
   if (auto t = root.table("settle")) {
     t->integer("max_steps", d.settle.max_steps, 0, 20000);
     t->integer("min_steps", d.settle.min_steps, 0, 20000);

@@ -79,7 +79,7 @@ void push_step_telemetry(const SimulationModel& model, bool stepped, std::uint64
 // The current case's score card, criteria and totals (score() scans the world: call at a low rate).
 void push_scores(SimulationModel& model, std::int64_t step, bool final_score, telemetry::TelemetrySource& out) {
   const std::string_view case_id = model.scene().description.name;
-  out.push(telemetry::score_item(model.metrics().score(), case_id, step, final_score));
+  out.push(telemetry::score_item(model.metrics().score(), case_id, step, final_score, model.scene().description.pass_score));
   out.push(telemetry::criteria_item(model.metrics().criteria(), case_id, step, final_score));  // what score() just measured
   out.push(telemetry::totals_item(model.metrics(), case_id, step, final_score));
 }
@@ -126,6 +126,9 @@ std::vector<std::string> score_lines(SimulationModel& model) {
   }
   std::snprintf(buf, sizeof buf, "%.0f / 100 (", card.total);
   lines.push_back(buf + cats + ")");
+  const double pass = model.scene().description.pass_score;
+  std::snprintf(buf, sizeof buf, "pass score %.0f: %s (%.1f)", pass, card.total >= pass ? "passed" : "not passed", card.total);
+  lines.push_back(buf);
   for (const core::CriterionProgress& c : model.metrics().criteria()) {
     std::snprintf(buf, sizeof buf, "%s%s%s: %.3g (goal %.3g) %s", core::to_string(c.kind), c.target.empty() ? "" : " ",
                   c.target.c_str(), c.value, c.threshold, c.met ? "met" : "not met");

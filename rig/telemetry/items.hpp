@@ -90,6 +90,7 @@ struct Score {
   std::uint8_t n = 0;
   char name[kMaxMetrics][24] = {};
   double value[kMaxMetrics] = {};
+  double pass_score = 0;  // the case's ([proficiency] pass_score)
 };
 
 // The case's criteria with a score card (criteria_t).

@@ -76,8 +76,9 @@ bool tissue_event_passed_on(const core::TissueEvent& e, const std::vector<core::
   });
 }
 
-Score score_item(const core::ScoreCard& card, std::string_view case_id, std::int64_t step, bool final_score) {
+Score score_item(const core::ScoreCard& card, std::string_view case_id, std::int64_t step, bool final_score, double pass_score) {
   Score s;
+  s.pass_score = pass_score;
   s.step = step;
   copy_text(s.case_id, case_id);
   s.final_score = final_score;
@@ -356,6 +357,7 @@ vitreo_lcm::score_t to_lcm(const Score& v, std::int64_t utime_us) {
     m.name.emplace_back(text(v.name[i]));
     m.value.push_back(v.value[i]);
   }
+  m.pass_score = v.pass_score;
   return m;
 }
 

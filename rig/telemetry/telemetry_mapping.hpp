@@ -73,7 +73,8 @@ void step_event_items(const std::vector<core::TissueEvent>& tissue_events, const
 
 // score_t, criteria_t and session_totals_t of the current case (score() and criteria() as the
 // metrics measured them last).
-Score score_item(const core::ScoreCard& card, std::string_view case_id, std::int64_t step, bool final_score);
+// pass_score: the case's ([proficiency] pass_score), carried on every card.
+Score score_item(const core::ScoreCard& card, std::string_view case_id, std::int64_t step, bool final_score, double pass_score);
 Criteria criteria_item(const std::vector<core::CriterionProgress>& criteria, std::string_view case_id, std::int64_t step, bool final_score);
 Totals totals_item(const core::SessionMetrics& metrics, std::string_view case_id, std::int64_t step, bool final_score);
 

@@ -90,6 +90,7 @@ void lcm_seeds(const fs::path& messages, const fs::path& command) {
   s.n = 2;
   s.name = {"target_achievement", "efficiency"};
   s.value = {40.0, 75.0};
+  s.pass_score = 80.0;
   write(messages, "score", encoded(s, 4));
   vitreo_lcm::device_status_t ds{};
   ds.name = "tracker-0";

@@ -51,7 +51,25 @@ for a in case["attempts"]:
     assert a["passed"] == (r["score"]["final"] and r["score"]["total"]["value"] >= 25)
 assert case["attempts"][2]["passed"] and not case["attempts"][0]["passed"], case["attempts"]
 assert case["first_passed_attempt"] == 3 and case["best"]["value"] == max(a["total"]["value"] for a in case["attempts"])
+assert case["pass_score"]["value"] == 25 and case["pass_score_from"] == "--pass", case["pass_score"]
 print("history:", [(a["folder"], round(a["total"]["value"], 1), a["passed"]) for a in case["attempts"]])
+PY
+# Without --pass each case is judged against its own pass score, which its reports carry (the case
+# file's [proficiency] pass_score, read here from the file itself).
+"$report" "$work/root" --trainee fellow-07 --out "$work/own" --generated "2026-01-01 00:00:00 UTC" > /dev/null
+python3 - "$work/root" "$work/own" "$(dirname "$0")/../../../scenes/exercise_pull_tissue.toml" <<'PY'
+import json, re, sys
+root, own, case_file = sys.argv[1:]
+want = float(re.search(r"^\[proficiency\]\npass_score = ([0-9.]+)$", open(case_file).read(), re.M).group(1))
+h = json.load(open(f"{own}/history-fellow-07.json"))
+assert h["pass_score"] is None, h["pass_score"]
+(case,) = h["cases"]
+assert case["pass_score"]["value"] == want and case["pass_score_from"] == "case file", (case["pass_score"], want)
+for a in case["attempts"]:
+    r = json.load(open(f'{root}/{a["folder"]}/report.json'))
+    assert r["case"]["pass_score"]["value"] == want
+    assert a["passed"] == r["case"]["passed"] == (r["score"]["final"] and r["score"]["total"]["value"] >= want), (a, r["case"])
+print("history with the case's own pass score", want, [(a["folder"], a["passed"]) for a in case["attempts"]])
 PY
 timeout 60 chromium --headless --no-sandbox --disable-gpu --no-first-run --user-data-dir="$work/profile" \
   --proxy-server=127.0.0.1:9 --enable-logging=stderr --v=0 --virtual-time-budget=1000 \

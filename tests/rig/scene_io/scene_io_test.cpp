@@ -190,6 +190,16 @@ TEST(SceneFiles, ViewTableIsReadWithItsDefaults) {
   EXPECT_TRUE(v.view.chandelier);
 }
 
+// Issue 17: a case's pass score, 70 when its file names none; every shipped case names its own.
+TEST(SceneFiles, APassScoreIsReadFromTheProficiencyTable) {
+  EXPECT_EQ(scene_io::parse_scene("format_version = 1\nname = \"p\"\n", "plain.toml").pass_score, 70.0);
+  EXPECT_EQ(scene_io::parse_scene("format_version = 1\nname = \"p\"\n[proficiency]\npass_score = 82.5\n", "p.toml").pass_score, 82.5);
+  for (const auto& e : fs::directory_iterator(fs::path(VITREO_SOURCE_DIR) / "scenes")) {
+    if (e.path().extension() != ".toml" || e.path().filename() == "materials.toml") continue;
+    EXPECT_NE(read(e.path().string()).find("\n[proficiency]\npass_score = "), std::string::npos) << e.path() << " names no pass score";
+  }
+}
+
 // Issue 15: the core's blades can be offered by a case (a misspelt name is refused: bad/29_*).
 TEST(SceneFiles, CasesOfferTheStraightAndTheSidewaysBlade) {
   const core::SceneDescription d = scene_io::parse_scene(

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <string>
@@ -410,8 +411,18 @@ TEST(TelemetryContract, ScoresControlsAcksAndReceiveStatusAsDocumented) {
   ASSERT_EQ(scores.size(), criteria.size());
   ASSERT_EQ(scores.size(), totals.size());
   ASSERT_GE(scores.size(), 2u) << "at 1000 steps and with the last";
+  // The case file's pass score, read here from its text (its [proficiency] table's one line).
+  double pass_score = -1;
+  {
+    std::ifstream in(std::string(VITREO_SOURCE_DIR) + "/scenes/exercise_pull_tissue.toml");
+    for (std::string l; std::getline(in, l);) {
+      if (l.rfind("pass_score", 0) == 0) pass_score = std::stod(l.substr(l.find('=') + 1));
+    }
+  }
+  ASSERT_GT(pass_score, 0) << "the case file names its pass score";
   for (std::size_t k = 0; k < scores.size(); ++k) {
     EXPECT_EQ(scores[k].case_id, "exercise_pull_tissue");
+    EXPECT_EQ(scores[k].pass_score, pass_score);
     EXPECT_EQ(criteria[k].step, scores[k].step);
     EXPECT_EQ(totals[k].step, scores[k].step);
     EXPECT_EQ(criteria[k].final_score, scores[k].final_score);
