@@ -231,6 +231,16 @@ BuiltTear cut_u_tear(TriangleMesh& mesh, const EyeModel& eye, const TearSpec& t)
   return out;
 }
 
+// A case gives an attachment's stiffness and break force as they are at the resolution the cases are
+// written for (kReferenceRetinaVertices, the rig's 5k). An attachment stands for the tissue around
+// it, stride vertices' worth; at N retina vertices a vertex covers 5000/N of the area it covers at
+// 5k, and so does each attachment (membranes and the gel's cortex are meshed at the retina's
+// resolution). Springs in parallel: the stiffness and break force per attachment scale by that
+// share, so the adhesion per mm² — the tissue's property — and the force a peel takes are the same
+// at any resolution. At 5k the factor is exactly 1.
+constexpr double kReferenceRetinaVertices = 5000.0;
+double attachment_area_scale(const EyeModel& eye) { return kReferenceRetinaVertices / eye.parameters.retina_vertices; }
+
 bool is_strong(const MembraneSpec& m, std::uint32_t index) {
   switch (m.strength) {
     case AttachmentStrength::kWeak: return false;
@@ -373,8 +383,8 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
     a.vertex_a = v;
     a.surface_b = scene.retina;
     a.vertex_b = from_retina[v];
-    a.stiffness_un_per_mm = 2e3;
-    a.break_force_un = strong ? spec.strong_break_force_un : spec.weak_break_force_un;
+    a.stiffness_un_per_mm = 2e3 * attachment_area_scale(eye);
+    a.break_force_un = (strong ? spec.strong_break_force_un : spec.weak_break_force_un) * attachment_area_scale(eye);
     a.rest_length_mm = spec.elevation_mm;
     world.add_attachment(a);
     ++out.attachment_count;
@@ -576,8 +586,8 @@ Scene build_scene(const SceneDescription& description, const BuildOptions& optio
       a.vertex_a = g;
       a.surface_b = scene.retina;
       a.vertex_b = r;
-      a.stiffness_un_per_mm = 2e2;
-      a.break_force_un = description.gel_adhesion_break_force_un;
+      a.stiffness_un_per_mm = 2e2 * attachment_area_scale(scene.eye);
+      a.break_force_un = description.gel_adhesion_break_force_un * attachment_area_scale(scene.eye);
       w.add_attachment(a);
       ++scene.gel_attachments;
     }

@@ -220,6 +220,54 @@ TEST(SceneBuilder, BuildsTearsMembranesGelAndSettles) {
   EXPECT_GT(max_retina_lift_mm(s), 0.5);
 }
 
+// A membrane's adhesion per mm² (the sum of its attachments' break forces over its area, the area
+// summed here from its triangles' corners) is the tissue's, not the mesh's: the same at the rig's 5k
+// retina and at 20k, where it has four times the attachments. At 5k each attachment holds exactly
+// what the case gives (the cases are written at 5k).
+TEST(SceneBuilder, AMembranesAdhesionPerAreaDoesNotDependOnTheMesh) {
+  double per_mm2[2] = {0, 0};
+  std::uint32_t count[2] = {0, 0};
+  const int vertices[2] = {5000, 20000};
+  for (int k = 0; k < 2; ++k) {
+    SceneDescription d;
+    d.name = "adhesion";
+    d.anatomy.retina_vertices = vertices[k];
+    d.anatomy.gel_shells = 0;
+    d.texture_size_px = 64;
+    d.materials = default_materials();
+    MembraneSpec erm;
+    erm.name = "erm";
+    erm.center = {30.0, 0.0};
+    erm.size_mm = 3.0;
+    erm.strength = AttachmentStrength::kWeak;
+    erm.weak_break_force_un = 40.0;
+    d.membranes.push_back(erm);
+    d.settle.max_steps = 0;
+    d.settle.min_steps = 0;
+    const Scene s = build_scene(d);
+    const BuiltMembrane& m = s.membranes.at(0);
+    const Surface& ms = s.world.surface(m.surface);
+    double area = 0;
+    for (std::uint32_t t = 0; t < ms.triangle_slots(); ++t) {
+      if (!ms.triangle_alive(t)) continue;
+      const auto v = ms.triangle_vertices(t);
+      area += 0.5 * (ms.position(v[1]) - ms.position(v[0])).cross(ms.position(v[2]) - ms.position(v[0])).norm();
+    }
+    double force = 0;
+    for (std::uint32_t i = m.first_attachment; i < m.first_attachment + m.attachment_count; ++i) {
+      force += s.world.attachment_break_force(i);
+      if (k == 0) {
+        ASSERT_EQ(s.world.attachment_break_force(i), 40.0) << "at 5k exactly the case's value";
+      }
+    }
+    count[k] = m.attachment_count;
+    per_mm2[k] = force / area;
+    std::printf("%d vertices: %u attachments over %.2f mm², %.1f uN/mm²\n", vertices[k], m.attachment_count, area, per_mm2[k]);
+  }
+  EXPECT_GT(count[1], 3 * count[0]) << "the finer mesh has about four times the attachments";
+  EXPECT_NEAR(per_mm2[1] / per_mm2[0], 1.0, 0.15);
+}
+
 TEST(SceneBuilder, SameDescriptionSameHash) {
   const Scene a = build_scene(busy_scene());
   const Scene b = build_scene(busy_scene());
