@@ -19,6 +19,8 @@
 namespace vitreo::core {
 
 inline constexpr int kSceneFormatVersion = 1;
+// A case's pass score when its file names none ([proficiency] pass_score).
+inline constexpr double kDefaultPassScore = 70.0;
 
 struct FundusLocation {
   double polar_deg = 0.0;
@@ -160,7 +162,7 @@ struct SceneDescription {
   // [proficiency] pass_score: the final score (0..100) an attempt must reach to pass this case. The
   // instructor's standard for the case, published with every score card, so the debrief and a
   // trainee's history say which attempts passed.
-  double pass_score = 70.0;
+  double pass_score = kDefaultPassScore;
   SettleSpec settle;
   ViewSpec view;
   std::string source_file;  // where it was read from (diagnostics)

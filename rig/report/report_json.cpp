@@ -230,6 +230,19 @@ const char* device_state_name(int state) {
   }
 }
 
+// The causes a device's frames were refused for, as report.json names them and as the line below
+// says them, in PROTOCOL.md's receiver order.
+struct RefusalCause {
+  const char* key;
+  const char* words;
+  std::int64_t DeviceRecord::*count;
+};
+constexpr RefusalCause kRefusalCauses[] = {
+    {"crc", "CRC", &DeviceRecord::crc_errors},          {"framing", "framing", &DeviceRecord::framing_errors},
+    {"version", "version", &DeviceRecord::version_rejected}, {"unknown_type", "type", &DeviceRecord::unknown_type_rejected},
+    {"length", "length", &DeviceRecord::length_rejected}, {"range", "out of range or NaN", &DeviceRecord::range_rejected},
+    {"identity", "identity", &DeviceRecord::identity_rejected}, {"protocol", "protocol", &DeviceRecord::protocol_rejected}};
+
 // One line of what went wrong with a device ("" when nothing did): what an instructor reads before
 // trusting the score, and a technician before the next session.
 std::string device_fault_sentence(const DeviceRecord& d) {
@@ -241,22 +254,15 @@ std::string device_fault_sentence(const DeviceRecord& d) {
   for (const auto& sp : d.spells) ++spells[sp.what];
   for (const auto& [what, n] : spells) parts.push_back(what + " " + std::to_string(n) + (n == 1 ? " time" : " times"));
   if (d.stuck_samples > 0) parts.push_back(std::to_string(d.stuck_samples) + " samples frozen while stuck");
-  const std::int64_t refused = d.crc_errors + d.framing_errors + d.version_rejected + d.unknown_type_rejected + d.length_rejected +
-                               d.range_rejected + d.identity_rejected + d.protocol_rejected;
-  if (refused > 0) {
-    std::string r = std::to_string(refused) + " frames refused (";
-    const std::pair<const char*, std::int64_t> causes[] = {{"CRC", d.crc_errors},          {"framing", d.framing_errors},
-                                                           {"version", d.version_rejected}, {"type", d.unknown_type_rejected},
-                                                           {"length", d.length_rejected},   {"out of range or NaN", d.range_rejected},
-                                                           {"identity", d.identity_rejected}, {"protocol", d.protocol_rejected}};
-    bool first = true;
-    for (const auto& [name, n] : causes) {
-      if (n == 0) continue;
-      r += (first ? "" : ", ") + std::string(name) + " " + std::to_string(n);
-      first = false;
-    }
-    parts.push_back(r + ")");
+  std::int64_t refused = 0;
+  std::string causes;
+  for (const RefusalCause& c : kRefusalCauses) {
+    const std::int64_t n = d.*c.count;
+    if (n == 0) continue;
+    refused += n;
+    causes += (causes.empty() ? "" : ", ") + std::string(c.words) + " " + std::to_string(n);
   }
+  if (refused > 0) parts.push_back(std::to_string(refused) + " frames refused (" + causes + ")");
   count(d.sequence_gaps, "frames missing from the sequence (lost on the way or refused)");
   count(d.timestamp_jumps, "timestamp jumps");
   count(d.heartbeat_misses, "heartbeat misses");
@@ -581,14 +587,7 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     j.key("status_messages").value(static_cast<std::int64_t>(d.status_messages));
     j.key("frames_rx").value(d.frames_rx);
     j.key("refused").begin_object();
-    j.key("crc").value(d.crc_errors);
-    j.key("framing").value(d.framing_errors);
-    j.key("version").value(d.version_rejected);
-    j.key("unknown_type").value(d.unknown_type_rejected);
-    j.key("length").value(d.length_rejected);
-    j.key("range").value(d.range_rejected);
-    j.key("identity").value(d.identity_rejected);
-    j.key("protocol").value(d.protocol_rejected);
+    for (const RefusalCause& c : kRefusalCauses) j.key(c.key).value(d.*c.count);
     j.end_object();
     j.key("sequence_gaps").value(d.sequence_gaps);
     j.key("heartbeat_misses").value(d.heartbeat_misses);

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/scene/scene_description.hpp"
 #include "rig/report/atomic_file.hpp"
 #include "rig/report/json_writer.hpp"
 
@@ -107,7 +108,7 @@ HistoryFiles write_history(const std::string& root, const std::string& trainee, 
     int first_pass = 0;
     // The case's pass score: the instructor's for all cases, else the newest report's (the case file
     // as it was at that session), else the default for reports that carry none.
-    double pass_score = kDefaultPassScore;
+    double pass_score = core::kDefaultPassScore;  // a report that carries none: written before cases had one
     const char* from = "default (the reports carry none)";
     if (pass_override) {
       pass_score = *pass_override;

@@ -22,9 +22,6 @@ struct HistoryFiles {
   int skipped = 0;  // folders with a report.json that could not be read
 };
 
-// The pass score of a report that carries none (written before cases had one).
-inline constexpr double kDefaultPassScore = 70.0;
-
 // Writes OUT/history-ID.json and OUT/history-ID.html. pass_override: one pass score for every case
 // instead of each case's own. Throws std::runtime_error for an invalid id, an unreadable ROOT, or no
 // session of that trainee under it.
