@@ -459,7 +459,17 @@ void BM_RendererOverhead(benchmark::State& state, int triangles) {
   state.counters["tris_per_eye"] = static_cast<double>(count_triangles(scene));
 }
 
+// Which GL the figures are from (llvmpipe here, a GPU's driver on a rig) goes into the output's context.
+void name_the_gl() {
+  try {
+    benchmark::AddCustomContext("egl", context().description());
+  } catch (const std::exception& e) {
+    benchmark::AddCustomContext("egl", std::string("unavailable: ") + e.what());
+  }
+}
+
 const bool registered = [] {
+  name_the_gl();
   for (int tris : {2000, 20000, 100000}) {
     const std::string size = "/1280x1024/" + std::to_string(tris) + "tris";
     benchmark::RegisterBenchmark(("BM_StereoFrame" + size).c_str(), BM_StereoFrame, tris)

@@ -121,6 +121,8 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMillisecond)
         ->Iterations(12);
   }
+  // Which GL the figures are from (llvmpipe here, a GPU's driver on a rig).
+  benchmark::AddCustomContext("egl", context().description());
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
