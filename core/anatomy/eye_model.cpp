@@ -6,13 +6,14 @@
 #include <string>
 
 #include "core/common/validate.hpp"
+#include "core/common/units.hpp"
 
 namespace vitreo::core {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
+using units::kDeg;
+using units::kPi;
 constexpr int kProfileSamples = 1441;  // polar angle samples pole → pole (1/8°)
 
 // Cross-section of a surface that is star-shaped about the origin: radius as a function of the polar

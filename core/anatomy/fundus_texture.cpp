@@ -6,12 +6,13 @@
 #include <numbers>
 
 #include "core/common/status.hpp"
+#include "core/common/units.hpp"
 
 namespace vitreo::core {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using units::kPi;
 // Vessel colours (linear 0..1): oxygenated arterial blood is a brighter red, venous blood darker
 // and bluer.
 constexpr double kArtery[3] = {0.74, 0.14, 0.10};

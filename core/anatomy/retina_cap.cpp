@@ -9,21 +9,18 @@
 #include "core/common/validate.hpp"
 #include "core/geometry/revolved_mesh.hpp"
 #include "core/topology/clean_topology.hpp"
+#include "core/common/units.hpp"
 
 namespace vitreo::core {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using units::kDeg;
 
 // Unit direction from the globe centre at polar angle theta from the posterior pole (−z) and
 // azimuth phi (0 = +x, nasal).
 Vec3 direction(double theta_rad, double phi_rad) {
   return {std::sin(theta_rad) * std::cos(phi_rad), std::sin(theta_rad) * std::sin(phi_rad), -std::cos(theta_rad)};
-}
-
-double angle_between(const Vec3& a, const Vec3& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
 }
 
 }  // namespace

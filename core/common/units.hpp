@@ -11,7 +11,13 @@
 // Names carry their unit as a suffix (`radius_mm`, `pressure_pa`, `dt_s`) wherever a value crosses
 // an API; inside tight loops the unit is implied by these rules.
 
+#include <numbers>
+
 namespace vitreo::core::units {
+
+// Angles: radians inside the core; files a person writes give degrees (`angle_deg * kDeg`).
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kDeg = kPi / 180.0;  // one degree in radians
 
 inline constexpr double kPascalPerMmHg = 133.322387415;
 inline constexpr double kGramPerMm3PerGramPerMl = 1e-3;

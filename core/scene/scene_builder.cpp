@@ -8,13 +8,14 @@
 
 #include "core/common/validate.hpp"
 #include "core/topology/clean_topology.hpp"
+#include "core/common/units.hpp"
 
 namespace vitreo::core {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
+using units::kDeg;
+using units::kPi;
 
 // Tangent frame on the wall at a fundus location: e_merid points anterior (increasing polar angle),
 // e_circ along increasing azimuth, inward toward the globe centre.
@@ -460,7 +461,7 @@ Guide build_guide(const Scene& scene, const GuideSpec& g) {
     }
   } else if (g.kind == GuideKind::kTarget) {
     // Targets are points, one per listed location, in order (no line between them).
-    for (const auto& p : g.points) out.polyline_mm.push_back(eye.wall_point(p.polar_deg * kDeg, p.azimuth_deg * kDeg));
+    for (const auto& p : g.points) out.polyline_mm.push_back(wall_point_at(eye, p));
   } else {
     for (std::size_t i = 0; i + 1 < g.points.size(); ++i) {
       const auto& a = g.points[i];
@@ -471,7 +472,7 @@ Guide build_guide(const Scene& scene, const GuideSpec& g) {
                                                  (a.azimuth_deg + s * (b.azimuth_deg - a.azimuth_deg)) * kDeg));
       }
     }
-    out.polyline_mm.push_back(eye.wall_point(g.points.back().polar_deg * kDeg, g.points.back().azimuth_deg * kDeg));
+    out.polyline_mm.push_back(wall_point_at(eye, g.points.back()));
   }
   // Lift off the wall by half a retina so the line lies on the retina's surface.
   for (auto& p : out.polyline_mm) p -= p.normalized() * (0.5 * eye.parameters.retina_thickness_mm);
@@ -602,7 +603,7 @@ Scene build_scene(const SceneDescription& description, const BuildOptions& optio
     f.surface = scene.retina;
     f.toward_point_mm = Vec3::Zero();
     f.pressure_pa = w.environment().intraocular_pressure_pa + d.pressure_pa;
-    const Vec3 center = e.wall_point(d.center.polar_deg * kDeg, d.center.azimuth_deg * kDeg).normalized();
+    const Vec3 center = wall_point_at(e, d.center).normalized();
     const double radius = d.radius_deg * kDeg;
     for (std::uint32_t v = 0; v < rs.vertex_slots(); ++v) {
       if (!rs.vertex_alive(v) || rs.is_fixed(v)) continue;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/anatomy/eye_model.hpp"
+#include "core/common/units.hpp"
 #include "core/tissue/material.hpp"
 
 namespace vitreo::core {
@@ -26,6 +27,11 @@ struct FundusLocation {
   double polar_deg = 0.0;
   double azimuth_deg = 0.0;
 };
+
+// The point of the eye's wall at a fundus location.
+inline Vec3 wall_point_at(const EyeModel& eye, const FundusLocation& at) {
+  return eye.wall_point(at.polar_deg * units::kDeg, at.azimuth_deg * units::kDeg);
+}
 
 // Subretinal fluid: the thesis' local radial force pulling the retina toward the centre (ch. 2.4).
 struct DetachmentSpec {

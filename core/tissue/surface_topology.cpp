@@ -278,7 +278,6 @@ Surface::RemoveResult Surface::remove_triangle(TriangleId id, bool separate) {
 
 
 namespace {
-double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 // Smallest corner angle of a triangle given its three edge vectors d0 = v0→v1, d1 = v1→v2, d2 = v2→v0.
 double min_angle(const Vec3& d0, const Vec3& d1, const Vec3& d2) {
   return std::min({angle_between(d0, -d2), angle_between(d1, -d0), angle_between(d2, -d1)});

@@ -1,4 +1,5 @@
 #include "rig/report/report_html.hpp"
+#include "rig/report/page_template.hpp"
 
 #include <stdexcept>
 
@@ -12,14 +13,6 @@ std::string_view page();     // report_page.html, embedded at build time
 }  // namespace assets
 
 namespace {
-
-// Replaces the one occurrence of `marker` in `page` (the template must hold each marker once).
-void fill(std::string& page, std::string_view marker, std::string_view with) {
-  const auto at = page.find(marker);
-  if (at == std::string::npos || page.find(marker, at + 1) != std::string::npos)
-    throw std::logic_error("report page template: marker " + std::string(marker) + " missing or repeated");
-  page.replace(at, marker.size(), with);
-}
 
 std::string html_text(std::string_view s) {
   std::string out;

@@ -1,4 +1,5 @@
 #include "rig/report/trainee_history.hpp"
+#include "rig/report/page_template.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -39,12 +40,6 @@ std::string slurp(const fs::path& p) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-void fill(std::string& page, std::string_view marker, std::string_view with) {
-  const auto at = page.find(marker);
-  if (at == std::string::npos) throw std::logic_error("history page template: marker missing");
-  page.replace(at, marker.size(), with);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include "rig/scene_io/scene_file.hpp"
+#include "rig/scene_io/toml_lines.hpp"
 
 #include "core/common/status.hpp"
 
@@ -24,7 +25,7 @@ namespace {
 
 using core::InvalidArgument;
 
-int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+using rig::line_of;
 
 // A TOML table being read: typed getters that record which keys were used, so finish() can refuse
 // the rest; every error carries file, line and the full key.

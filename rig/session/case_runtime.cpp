@@ -10,28 +10,23 @@ namespace vitreo::rig {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-core::Vec3 on_wall(const core::EyeModel& eye, const core::FundusLocation& at) {
-  return eye.wall_point(at.polar_deg * kDeg, at.azimuth_deg * kDeg);
-}
 
 // Where the surgeon will look first: the case's own choice, else the pathology it is about.
 core::Vec3 region_of_interest(const core::Scene& s) {
   const auto& d = s.description;
-  if (d.view.region_of_interest) return on_wall(s.eye, *d.view.region_of_interest);
-  if (!d.tears.empty()) return on_wall(s.eye, d.tears.front().center);
-  if (!d.membranes.empty()) return on_wall(s.eye, d.membranes.front().center);
-  if (!d.detachments.empty()) return on_wall(s.eye, d.detachments.front().center);
+  if (d.view.region_of_interest) return core::wall_point_at(s.eye, *d.view.region_of_interest);
+  if (!d.tears.empty()) return core::wall_point_at(s.eye, d.tears.front().center);
+  if (!d.membranes.empty()) return core::wall_point_at(s.eye, d.membranes.front().center);
+  if (!d.detachments.empty()) return core::wall_point_at(s.eye, d.detachments.front().center);
   for (const auto& g : d.guides) {
     if (!g.points.empty()) {
       // The middle of the path, so the whole of it is in the field.
       core::Vec3 sum = core::Vec3::Zero();
-      for (const auto& p : g.points) sum += on_wall(s.eye, p);
+      for (const auto& p : g.points) sum += core::wall_point_at(s.eye, p);
       const core::Vec3 mean = sum / static_cast<double>(g.points.size());
       return s.eye.wall.radius_toward(mean) * mean.normalized();
     }
-    if (g.around.empty()) return on_wall(s.eye, g.center);
+    if (g.around.empty()) return core::wall_point_at(s.eye, g.center);
   }
   return s.eye.fovea_mm;
 }
@@ -125,8 +120,8 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   for (std::size_t i = 0; i < s.detachment_forces.size() && i < s.description.detachments.size(); ++i) {
     core::DrainageSite site;
     site.local_force = s.detachment_forces[i];
-    site.break_point_mm = s.description.tears.empty() ? on_wall(s.eye, s.description.detachments[i].center)
-                                                      : on_wall(s.eye, s.description.tears.front().center);
+    site.break_point_mm = s.description.tears.empty() ? core::wall_point_at(s.eye, s.description.detachments[i].center)
+                                                      : core::wall_point_at(s.eye, s.description.tears.front().center);
     o.drainage_sites.push_back(site);
   }
   std::vector<core::InstrumentDescription> instruments;

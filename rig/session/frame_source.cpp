@@ -7,12 +7,13 @@
 #include <numbers>
 
 #include "rig/session/instrument_models.hpp"
+#include "core/common/units.hpp"
 
 namespace vitreo::rig {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using core::units::kDeg;
 
 render::Vec3 to_render(const core::Vec3& v) {
   return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
@@ -91,10 +92,6 @@ float detachment_of(const core::GlobeWall& wall, const core::Vec3& p, double thi
 // cached buffers or burn textures.
 std::uint32_t mesh_id(std::uint64_t serial, std::uint32_t local) {
   return static_cast<std::uint32_t>((serial % 1000) * 1000) + local;
-}
-
-core::Vec3 on_wall(const core::EyeModel& eye, const core::FundusLocation& at) {
-  return eye.wall_point(at.polar_deg * kDeg, at.azimuth_deg * kDeg);
 }
 
 // The wall point under a fundus-plane point (the inverse of EyeModel::fundus_coords on the wall).
@@ -215,9 +212,9 @@ std::unique_ptr<CaseVisuals> build_case_visuals(const PreparedCase& c) {
   auto named = [](const std::string& name, const std::string& kind) {
     return name.find(kind) == std::string::npos ? name + " " + kind : name;
   };
-  for (const auto& t : s.description.tears) label(on_wall(s.eye, t.center), named(t.name, "tear"));
-  for (const auto& m : s.description.membranes) label(on_wall(s.eye, m.center), named(m.name, "membrane"));
-  for (const auto& d : s.description.detachments) label(on_wall(s.eye, d.center), d.name);
+  for (const auto& t : s.description.tears) label(core::wall_point_at(s.eye, t.center), named(t.name, "tear"));
+  for (const auto& m : s.description.membranes) label(core::wall_point_at(s.eye, m.center), named(m.name, "membrane"));
+  for (const auto& d : s.description.detachments) label(core::wall_point_at(s.eye, d.center), d.name);
   // A boundary of the retina near the ora is where the retina ends, not a cut.
   v->retina_edge_polar_rad = s.eye.ora_polar_rad - 1.5 * kDeg;
   if (s.description.view.chandelier) {

@@ -9,8 +9,6 @@ namespace vitreo::rig {
 namespace {
 
 using render::MaterialKind;
-using render::Vec2;
-using render::Vec3;
 
 constexpr float kPi = 3.14159265f;
 
@@ -18,7 +16,7 @@ constexpr float kPi = 3.14159265f;
 struct Builder {
   std::shared_ptr<render::MeshGeometry> g = std::make_shared<render::MeshGeometry>();
 
-  std::uint32_t vertex(Vec3 p, Vec3 n, float highlight = 0.0f, Vec2 uv = {}) {
+  std::uint32_t vertex(render::Vec3 p, render::Vec3 n, float highlight = 0.0f, render::Vec2 uv = {}) {
     g->vertices.push_back({p, n, uv, 0.0f, highlight});
     return static_cast<std::uint32_t>(g->vertices.size() - 1);
   }
@@ -33,7 +31,7 @@ struct Builder {
     for (int i = 0; i <= sides; ++i) {
       const float a = 2.0f * kPi * static_cast<float>(i) / static_cast<float>(sides);
       const float c = std::cos(a), s = std::sin(a);
-      const Vec3 n = normalize(Vec3{c, s, slope});
+      const render::Vec3 n = normalize(render::Vec3{c, s, slope});
       vertex({cx + r0 * c, cy + r0 * s, z0}, n, h0, {static_cast<float>(i) / sides, 0.0f});
       vertex({cx + r1 * c, cy + r1 * s, z1}, n, h1, {static_cast<float>(i) / sides, 1.0f});
     }
@@ -45,10 +43,10 @@ struct Builder {
     if (cap_end && r1 > 0.0f) disc({cx, cy, z1}, {0, 0, z1 >= z0 ? 1.0f : -1.0f}, r1, sides, h1, h1);
   }
   // A disc (a fan) at `centre` facing `normal`, highlight hc at the centre → hr at the rim.
-  void disc(Vec3 centre, Vec3 normal, float radius, int sides, float hc = 0.0f, float hr = 0.0f) {
+  void disc(render::Vec3 centre, render::Vec3 normal, float radius, int sides, float hc = 0.0f, float hr = 0.0f) {
     normal = normalize(normal);
-    const Vec3 helper = std::fabs(normal.z) < 0.9f ? Vec3{0, 0, 1} : Vec3{1, 0, 0};
-    const Vec3 a = normalize(cross(normal, helper)), b = cross(normal, a);
+    const render::Vec3 helper = std::fabs(normal.z) < 0.9f ? render::Vec3{0, 0, 1} : render::Vec3{1, 0, 0};
+    const render::Vec3 a = normalize(cross(normal, helper)), b = cross(normal, a);
     const std::uint32_t c = vertex(centre, normal, hc);
     for (int i = 0; i <= sides; ++i) {
       const float t = 2.0f * kPi * static_cast<float>(i) / static_cast<float>(sides);
@@ -58,18 +56,18 @@ struct Builder {
   }
   // A flat plate: the convex outline (across, along) in the plane spanned by `across` and `along`
   // from `origin`, given `thickness` along across × along (both faces and the rim).
-  void plate(Vec3 origin, Vec3 across, Vec3 along, const std::vector<Vec2>& outline, float thickness) {
-    const Vec3 n = normalize(cross(across, along));
+  void plate(render::Vec3 origin, render::Vec3 across, render::Vec3 along, const std::vector<render::Vec2>& outline, float thickness) {
+    const render::Vec3 n = normalize(cross(across, along));
     const std::size_t k = outline.size();
     for (float side : {-0.5f, 0.5f}) {
       const std::uint32_t first = static_cast<std::uint32_t>(g->vertices.size());
-      for (const Vec2& o : outline) vertex(origin + across * o.x + along * o.y + n * (side * thickness), n * side);
+      for (const render::Vec2& o : outline) vertex(origin + across * o.x + along * o.y + n * (side * thickness), n * side);
       for (std::size_t i = 1; i + 1 < k; ++i) tri(first, first + static_cast<std::uint32_t>(i), first + static_cast<std::uint32_t>(i + 1));
     }
     for (std::size_t i = 0; i < k; ++i) {
-      const Vec2 p = outline[i], q = outline[(i + 1) % k];
-      const Vec3 pa = origin + across * p.x + along * p.y, qa = origin + across * q.x + along * q.y;
-      const Vec3 edge_n = normalize(cross(qa - pa, n));
+      const render::Vec2 p = outline[i], q = outline[(i + 1) % k];
+      const render::Vec3 pa = origin + across * p.x + along * p.y, qa = origin + across * q.x + along * q.y;
+      const render::Vec3 edge_n = normalize(cross(qa - pa, n));
       const std::uint32_t a = vertex(pa - n * (0.5f * thickness), edge_n), b = vertex(pa + n * (0.5f * thickness), edge_n);
       const std::uint32_t c = vertex(qa - n * (0.5f * thickness), edge_n), d = vertex(qa + n * (0.5f * thickness), edge_n);
       tri(a, c, b);
@@ -79,7 +77,7 @@ struct Builder {
 };
 
 render::Mesh make_mesh(Builder& b, std::uint32_t id, MaterialKind material, const render::Mat4& model, std::uint64_t version,
-                       Vec3 tint = {1, 1, 1}, float opacity = -1.0f) {
+                       render::Vec3 tint = {1, 1, 1}, float opacity = -1.0f) {
   render::Mesh m;
   m.id = id;
   m.material = material;
@@ -94,21 +92,21 @@ render::Mesh make_mesh(Builder& b, std::uint32_t id, MaterialKind material, cons
 }
 
 constexpr int kSides = 16;
-const Vec3 kSteel{1.0f, 1.0f, 1.0f};
-const Vec3 kDarkSteel{0.78f, 0.78f, 0.80f};
-const Vec3 kAimGreen{0.35f, 1.0f, 0.30f};
-const Vec3 kWarmWhite{1.0f, 0.96f, 0.86f};
+const render::Vec3 kSteel{1.0f, 1.0f, 1.0f};
+const render::Vec3 kDarkSteel{0.78f, 0.78f, 0.80f};
+const render::Vec3 kAimGreen{0.35f, 1.0f, 0.30f};
+const render::Vec3 kWarmWhite{1.0f, 0.96f, 0.86f};
 
 }  // namespace
 
-render::Mat4 instrument_placement(const Vec3& tip, const Vec3& axis, const Vec3& up) {
-  const Vec3 z = normalize(axis);
-  Vec3 x = up - z * dot(up, z);
-  if (length(x) < 1e-5f) x = std::fabs(z.x) < 0.9f ? Vec3{1, 0, 0} - z * z.x : Vec3{0, 1, 0} - z * z.y;
+render::Mat4 instrument_placement(const render::Vec3& tip, const render::Vec3& axis, const render::Vec3& up) {
+  const render::Vec3 z = normalize(axis);
+  render::Vec3 x = up - z * dot(up, z);
+  if (length(x) < 1e-5f) x = std::fabs(z.x) < 0.9f ? render::Vec3{1, 0, 0} - z * z.x : render::Vec3{0, 1, 0} - z * z.y;
   x = normalize(x);
-  const Vec3 y = cross(z, x);
+  const render::Vec3 y = cross(z, x);
   render::Mat4 m;
-  const Vec3 cols[4] = {x, y, z, tip};
+  const render::Vec3 cols[4] = {x, y, z, tip};
   for (int c = 0; c < 4; ++c) {
     m.at(0, c) = cols[c].x;
     m.at(1, c) = cols[c].y;
@@ -134,19 +132,19 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
       // (core: jaw_open_deg · (1 − actuation)), exactly where the core's jaw capsules lie.
       const float half = static_cast<float>(d.jaw_open_deg) * kPi / 180.0f * (1.0f - std::clamp(v.actuation, 0.0f, 1.0f));
       const float jr = static_cast<float>(d.jaw_radius_mm);
-      const Vec3 hinge{0, 0, -J};
+      const render::Vec3 hinge{0, 0, -J};
       out.push_back(make_mesh(metal, id++, MaterialKind::Instrument, model, version));
       Builder jaws;  // their own mesh: what the handle moves
       for (float side : {1.0f, -1.0f}) {
-        const Vec3 along{side * std::sin(half), 0.0f, std::cos(half)};
+        const render::Vec3 along{side * std::sin(half), 0.0f, std::cos(half)};
         if (v.kind == K::kForceps) {
           // End-gripping jaws: flat faces toward each other (across y), 2·jaw_radius thick, so the
           // gap between their faces is the core's jaw gap; a grasping platform at the end.
-          jaws.plate(hinge, Vec3{0, 1, 0}, along, {{-0.13f, 0.0f}, {0.13f, 0.0f}, {0.09f, J}, {-0.09f, J}}, 2.0f * jr);
+          jaws.plate(hinge, render::Vec3{0, 1, 0}, along, {{-0.13f, 0.0f}, {0.13f, 0.0f}, {0.09f, J}, {-0.09f, J}}, 2.0f * jr);
         } else {
           // Scissors: pointed blades in the opening plane, offset across so they shear past each other.
-          const Vec3 across{std::cos(half), 0.0f, -side * std::sin(half)};
-          jaws.plate(hinge + Vec3{0, side * 0.5f * jr, 0}, across * side, along,
+          const render::Vec3 across{std::cos(half), 0.0f, -side * std::sin(half)};
+          jaws.plate(hinge + render::Vec3{0, side * 0.5f * jr, 0}, across * side, along,
                      {{-0.03f, 0.0f}, {0.12f, 0.0f}, {0.0f, J}, {-0.03f, 0.85f * J}}, jr);
         }
       }
@@ -161,14 +159,14 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
       // back once per cut, so at 2500–7500 cuts/min the port flickers from frame to frame.
       const float setback = static_cast<float>(d.vitrector_port_setback_mm), half_len = 0.2f, half_w = 0.16f;
       Builder port;
-      port.plate({r + 0.004f, 0, -setback}, Vec3{0, 1, 0}, Vec3{0, 0, 1},
+      port.plate({r + 0.004f, 0, -setback}, render::Vec3{0, 1, 0}, render::Vec3{0, 0, 1},
                  {{-half_w, -half_len}, {half_w, -half_len}, {half_w, half_len}, {-half_w, half_len}}, 0.004f);
       out.push_back(make_mesh(port, id++, MaterialKind::Static, model, version, {0.04f, 0.03f, 0.03f}));
       const float cover = v.cutting ? 1.0f - std::fabs(2.0f * v.cut_phase - 1.0f) : 0.0f;  // 0 open … 1 closed
       if (cover > 0.02f) {
         Builder cutter;
         const float top = half_len, bottom = half_len - 2.0f * half_len * cover;
-        cutter.plate({r + 0.012f, 0, -setback}, Vec3{0, 1, 0}, Vec3{0, 0, 1},
+        cutter.plate({r + 0.012f, 0, -setback}, render::Vec3{0, 1, 0}, render::Vec3{0, 0, 1},
                      {{-half_w, bottom}, {half_w, bottom}, {half_w, top}, {-half_w, top}}, 0.004f);
         out.push_back(make_mesh(cutter, id++, MaterialKind::Instrument, model, version, {1.1f, 1.1f, 1.1f}));
       }
@@ -178,7 +176,7 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
       const float B = static_cast<float>(d.blade_length_mm);
       shaft_to(B);
       // A lanceolate (MVR) blade: two cutting edges meeting at the point.
-      metal.plate({0, 0, -B}, Vec3{1, 0, 0}, Vec3{0, 0, 1}, {{-0.2f, 0.0f}, {0.2f, 0.0f}, {0.27f, 0.45f * B}, {0.0f, B}, {-0.27f, 0.45f * B}},
+      metal.plate({0, 0, -B}, render::Vec3{1, 0, 0}, render::Vec3{0, 0, 1}, {{-0.2f, 0.0f}, {0.2f, 0.0f}, {0.27f, 0.45f * B}, {0.0f, B}, {-0.27f, 0.45f * B}},
                   0.03f);
       out.push_back(make_mesh(metal, id++, MaterialKind::Instrument, model, version, {1.05f, 1.05f, 1.08f}));
       break;
@@ -187,7 +185,7 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
       shaft_to(0.0f);
       // Bent 90° at the tip: its edge runs along v for sideways_blade_mm.
       const float S = static_cast<float>(d.sideways_blade_mm);
-      metal.plate({0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 0, 1}, {{0.0f, -0.3f}, {0.6f * S, -0.12f}, {S, 0.0f}, {0.0f, 0.06f}}, 0.03f);
+      metal.plate({0, 0, 0}, render::Vec3{1, 0, 0}, render::Vec3{0, 0, 1}, {{0.0f, -0.3f}, {0.6f * S, -0.12f}, {S, 0.0f}, {0.0f, 0.06f}}, 0.03f);
       out.push_back(make_mesh(metal, id++, MaterialKind::Instrument, model, version, {1.05f, 1.05f, 1.08f}));
       break;
     }
@@ -225,7 +223,7 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
         // The aiming beam (faint in clear fluid) and its spot on the tissue, where the core's ray
         // meets it: the laser will burn there. Built in the eye frame.
         Builder beam;
-        const Vec3 to = v.aim_mm - v.tip_mm;
+        const render::Vec3 to = v.aim_mm - v.tip_mm;
         const float len = length(to);
         if (len > 1e-3f) {
           beam.tube(0, 0, 0.0f, len, 0.012f, 0.02f, 6, false, 1.0f, 0.6f);
@@ -233,10 +231,10 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
                                   v.firing ? 0.9f : 0.25f));
         }
         Builder spot;
-        const Vec3 n = normalize(v.aim_normal);
+        const render::Vec3 n = normalize(v.aim_normal);
         spot.disc(v.aim_mm + n * 0.03f, n, 0.75f * v.aim_spot_mm, 20, 1.0f, 0.0f);
         out.push_back(make_mesh(spot, id++, MaterialKind::Glow, render::Mat4::identity(), version,
-                                v.firing ? Vec3{1.0f, 1.0f, 0.9f} : kAimGreen, v.firing ? 6.0f : 2.5f));
+                                v.firing ? render::Vec3{1.0f, 1.0f, 0.9f} : kAimGreen, v.firing ? 6.0f : 2.5f));
       }
       break;
     }
@@ -256,8 +254,8 @@ void add_instrument_meshes(const InstrumentView& v, std::uint32_t first_id, std:
   }
 }
 
-void add_chandelier_meshes(Vec3 base_mm, Vec3 direction, std::uint32_t first_id, std::vector<render::Mesh>& out) {
-  const render::Mat4 model = instrument_placement(base_mm, direction, Vec3{0, 0, 1});
+void add_chandelier_meshes(render::Vec3 base_mm, render::Vec3 direction, std::uint32_t first_id, std::vector<render::Mesh>& out) {
+  const render::Mat4 model = instrument_placement(base_mm, direction, render::Vec3{0, 0, 1});
   Builder fibre;
   fibre.tube(0, 0, -2.0f, 0.0f, 0.2f, 0.2f, 12, true);  // a 27-gauge fibre 2 mm into the cavity
   out.push_back(make_mesh(fibre, first_id, MaterialKind::Instrument, model, 1, {0.9f, 0.9f, 0.95f}));

@@ -1,4 +1,5 @@
 #include "rig/session/rig_file.hpp"
+#include "rig/scene_io/toml_lines.hpp"
 
 #include <toml++/toml.h>
 
@@ -34,7 +35,6 @@ std::string read_text(const std::string& path, const std::string& what) {
   return s.str();
 }
 
-int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
 
 }  // namespace
 

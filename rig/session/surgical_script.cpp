@@ -1,4 +1,5 @@
 #include "rig/session/surgical_script.hpp"
+#include "rig/scene_io/toml_lines.hpp"
 
 #include <toml++/toml.h>
 
@@ -14,14 +15,14 @@
 #include "firmware-protocol/vp.h"
 #include "rig/files/read_text_file.hpp"
 #include "rig/files/toml_guard.hpp"
+#include "core/common/units.hpp"
 
 namespace vitreo::rig {
 namespace {
 
 using core::Vec3;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using core::units::kDeg;
 
-int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
 
 // Reads one table's keys with file:line:key errors; refuses keys it was not asked for.
 class Reader {
@@ -242,7 +243,7 @@ class LandmarkResolver {
     const core::Scene& scene = *c_.scene;
     const Vec3 centre = scene.eye.wall.center();
     auto on_fundus = [&](const Vec3& p) { return Landmark{p, (centre - p).normalized()}; };
-    auto wall = [&](const core::FundusLocation& at) { return on_fundus(scene.eye.wall_point(at.polar_deg * kDeg, at.azimuth_deg * kDeg)); };
+    auto wall = [&](const core::FundusLocation& at) { return on_fundus(core::wall_point_at(scene.eye, at)); };
     const auto dot = name.find('.');
     const std::string head = name.substr(0, dot);
     const std::string rest = dot == std::string::npos ? "" : name.substr(dot + 1);

@@ -8,12 +8,12 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-static uint64_t s = 88172645463325252ull;
-static uint64_t next(void) {
-  s ^= s << 13;
-  s ^= s >> 7;
-  s ^= s << 17;
-  return s;
+static uint64_t xorshift_state = 88172645463325252ull;
+static uint64_t xorshift_next(void) {
+  xorshift_state ^= xorshift_state << 13;
+  xorshift_state ^= xorshift_state >> 7;
+  xorshift_state ^= xorshift_state << 17;
+  return xorshift_state;
 }
 
 int main(int argc, char** argv) {
@@ -36,14 +36,14 @@ int main(int argc, char** argv) {
     uint8_t buf[160];
     size_t n;
     if (nseeds && (it & 1)) {
-      size_t k = (size_t)(next() % nseeds), flips = 1 + next() % 4, j;
+      size_t k = (size_t)(xorshift_next() % nseeds), flips = 1 + xorshift_next() % 4, j;
       n = seed_len[k];
       memcpy(buf, seeds[k], n);
-      for (j = 0; j < flips && n; ++j) buf[next() % n] ^= (uint8_t)(1u << (next() % 8));
-      if (next() % 8 == 0 && n) n = (size_t)(next() % n);
+      for (j = 0; j < flips && n; ++j) buf[xorshift_next() % n] ^= (uint8_t)(1u << (xorshift_next() % 8));
+      if (xorshift_next() % 8 == 0 && n) n = (size_t)(xorshift_next() % n);
     } else {
-      n = (size_t)(next() % sizeof buf);
-      for (i = 0; i < n; ++i) buf[i] = (uint8_t)next();
+      n = (size_t)(xorshift_next() % sizeof buf);
+      for (i = 0; i < n; ++i) buf[i] = (uint8_t)xorshift_next();
     }
     LLVMFuzzerTestOneInput(buf, n);
   }
