@@ -27,3 +27,10 @@ if(VITREO_TSAN)
   target_compile_options(vitreo_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
   target_link_options(vitreo_options INTERFACE -fsanitize=thread)
 endif()
+
+# Unity batches (the sanitizer presets build that way, for time) #include the sources, so
+# GCC takes a class defined in a .cpp for one in a header and warns that its members have types from
+# an anonymous namespace (-Wsubobject-linkage); inside one translation unit that is harmless.
+if(CMAKE_UNITY_BUILD)
+  target_compile_options(vitreo_options INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-Wno-subobject-linkage>)
+endif()
