@@ -1,5 +1,5 @@
 #include "rig/scene_io/scene_file.hpp"
-#include "rig/scene_io/toml_lines.hpp"
+#include "rig/files/toml_lines.hpp"
 
 #include "core/common/status.hpp"
 
@@ -25,7 +25,7 @@ namespace {
 
 using core::InvalidArgument;
 
-using rig::line_of;
+using files::line_of;
 
 // A TOML table being read: typed getters that record which keys were used, so finish() can refuse
 // the rest; every error carries file, line and the full key.

@@ -1,5 +1,5 @@
 #include "rig/session/rig_file.hpp"
-#include "rig/scene_io/toml_lines.hpp"
+#include "rig/files/toml_lines.hpp"
 
 #include <toml++/toml.h>
 
@@ -27,6 +27,8 @@ const char* to_string(DeviceRole r) {
 
 namespace {
 
+using files::line_of;
+
 std::string read_text(const std::string& path, const std::string& what) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error(path + ": cannot read " + what);
@@ -34,7 +36,6 @@ std::string read_text(const std::string& path, const std::string& what) {
   s << f.rdbuf();
   return s.str();
 }
-
 
 }  // namespace
 

@@ -1,5 +1,5 @@
 #include "rig/session/surgical_script.hpp"
-#include "rig/scene_io/toml_lines.hpp"
+#include "rig/files/toml_lines.hpp"
 
 #include <toml++/toml.h>
 
@@ -22,7 +22,7 @@ namespace {
 
 using core::Vec3;
 using core::units::kDeg;
-
+using files::line_of;
 
 // Reads one table's keys with file:line:key errors; refuses keys it was not asked for.
 class Reader {
