@@ -35,6 +35,12 @@ void ThreadHarness::add_service(std::string name, std::chrono::nanoseconds perio
 void ThreadHarness::start() {
   if (started_) throw std::logic_error("ThreadHarness: started twice");
   started_ = true;
+  // spdlog's registry (the default logger) is a function-local static inside Debian's libspdlog,
+  // which is not built for ThreadSanitizer: created by the first thread that logs, its use by the
+  // next looks unordered to TSan (it cannot see the library's guard). It is no race — C++ makes the
+  // static's initialisation thread-safe — but creating it here, before the harness's threads start,
+  // gives it an order TSan sees (thread creation), as run_session does for the session's threads.
+  (void)spdlog::default_logger_raw();
   physics_ = std::thread([this] {
     pthread_setname_np(pthread_self(), "vitreo-physics");
     if (config_.physics_realtime) rt_outcome_ = apply_realtime(config_.physics_rt);

@@ -197,9 +197,18 @@ TEST(RigSession, RecordedInputsCarryTheDocumentedKindsAndFields) {
       default: ADD_FAILURE() << "undocumented kind " << int{m.device_kind};
     }
   }
-  EXPECT_GT(per_kind[1], 500) << "the tracker streamed";
-  EXPECT_GT(per_kind[2], 100) << "the eye fixture streamed";
-  EXPECT_GT(per_kind[3], 100) << "the pedals streamed";
+  // 1.5 s of a 1000 Hz tracker, 500 Hz pedals and a 250 Hz fixture, paced by the wall clock. Under
+  // ThreadSanitizer the emulators' and readers' threads run several times slower than the rig's
+  // clock (a TSan run recorded 246 tracker samples) and the gaps are counted as such; there the bar
+  // only asks that each device streamed at all, at a sixth of its rate.
+#if defined(VITREO_SANITIZER_BUILD) && defined(__SANITIZE_THREAD__)
+  const int tracker_bar = 100, others_bar = 20;
+#else
+  const int tracker_bar = 500, others_bar = 100;
+#endif
+  EXPECT_GT(per_kind[1], tracker_bar) << "the tracker streamed";
+  EXPECT_GT(per_kind[2], others_bar) << "the eye fixture streamed";
+  EXPECT_GT(per_kind[3], others_bar) << "the pedals streamed";
   EXPECT_GE(per_kind[4], 3) << "each link came up";
   EXPECT_EQ(per_kind[5], 1);
   EXPECT_TRUE(end_seen_last) << "the session end is the last input";
