@@ -447,6 +447,7 @@ int main(int argc, char** argv) {
                   s.pngs.size(), config.png_dir.c_str(), s.pngs.empty() ? "none" : (s.pngs.back() + "_stereo.png").c_str());
       std::printf("  instructor view  %s%s\n", s.pngs.empty() ? "none" : (s.pngs.back() + "_instructor.png").c_str(),
                   instructor_ring.empty() ? "" : (" and the shared-memory ring " + instructor_ring).c_str());
+      for (const auto& m : s.key_moment_frames) std::printf("  key moment       %s_instructor.png\n", m.c_str());
     }
     for (const auto& line : s.displays) std::printf("  display          %s\n", line.c_str());
     for (std::size_t i = 0; i < s.score_lines.size(); ++i)

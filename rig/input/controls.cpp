@@ -33,7 +33,11 @@ bool PedalMapper::apply(const PedalReading& raw) {
   for (const AxisRange& a : m_.axis_ranges)
     if (a.pedal_id == r.pedal_id && a.axis >= 0 && a.axis < r.axis_count) r.axes[a.axis] = a.apply(r.axes[a.axis]);
   auto axis = [&](int index) { return index >= 0 && index < r.axis_count ? r.axes[index] : 0.0; };
+  auto keep_travel = [&](double (&travel)[4]) {
+    for (int i = 0; i < 4; ++i) travel[i] = axis(i);
+  };
   if (r.pedal_id == m_.vitrectomy_pedal_id) {
+    keep_travel(c_.vitrectomy_travel);
     c_.vacuum_mmhg = axis(m_.vacuum_axis) * m_.vacuum_max_mmhg;
     const double travel = m_.cut_rate_axis >= 0 ? axis(m_.cut_rate_axis) : 1.0;
     c_.cut_rate_cpm = c_.vacuum_mmhg > 0.0 ? m_.cut_rate_min_cpm + travel * (m_.cut_rate_max_cpm - m_.cut_rate_min_cpm) : 0.0;
@@ -44,6 +48,7 @@ bool PedalMapper::apply(const PedalReading& raw) {
     if (bit(r.switches, m_.air_switch) && !bit(last_switches_[0], m_.air_switch)) c_.air_infusion = !c_.air_infusion;
     last_switches_[0] = r.switches;
   } else if (r.pedal_id == m_.microscope_pedal_id) {
+    keep_travel(c_.microscope_travel);
     c_.zoom = m_.zoom_min + axis(m_.zoom_axis) * (m_.zoom_max - m_.zoom_min);
     c_.focus_offset_mm = (axis(m_.focus_axis) - 0.5) * m_.focus_range_mm;
     // Joystick axes read 0.5 when absent: centred, so a two-axis pedal never drifts the field.

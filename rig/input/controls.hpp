@@ -66,6 +66,11 @@ struct SurgicalControls {
   double focus_offset_mm = 0.0;
   double pan_x = 0.0, pan_y = 0.0;  // joystick −1..1 (+x image right, +y image up), dead band removed
   double light_level = 0.7;  // 0..1 of the light source
+  // Each pedal's axes as the mapping read them: 0..1 of their travel after the axis calibration
+  // (axes the pedal does not have read 0). What the feet did, before it became vacuum, cut rate or
+  // zoom; the debrief draws it.
+  double vitrectomy_travel[4] = {};
+  double microscope_travel[4] = {};
 };
 
 struct PedalReading {

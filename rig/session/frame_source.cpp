@@ -232,7 +232,7 @@ std::unique_ptr<CaseVisuals> build_case_visuals(const PreparedCase& c) {
 
 void prepare_view_snapshots(PreparedCase& c) {
   const core::TissueWorld& world = c.scene->world;
-  c.spare_views.assign(3, ViewSnapshot{});
+  c.spare_views.assign(kViewSnapshotsPerCase, ViewSnapshot{});
   for (ViewSnapshot& s : c.spare_views) {
     s.case_serial = c.serial;
     s.visuals = c.visuals;

@@ -68,7 +68,9 @@ struct CaseVisuals {
 
 // Loader thread: the case's look. Needs the scene's textures (load with textures on).
 std::unique_ptr<CaseVisuals> build_case_visuals(const PreparedCase& c);
-// Loader thread: gives the case its three view snapshots, sized for its surfaces.
+// Loader thread: gives the case its view snapshots, sized for its surfaces: one for each slot of
+// the physics → render triple buffer, and one for the picture of a key moment (key_moments.hpp).
+inline constexpr std::size_t kViewSnapshotsPerCase = 4;
 void prepare_view_snapshots(PreparedCase& c);
 
 // Physics thread: copies the model's current state into `out` (no allocation: when `out` was sized

@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 #include <optional>
+#include <thread>
 
 #include "core/scene/snapshot.hpp"
 #include "rig/runtime/clock.hpp"
@@ -25,6 +26,7 @@
 #include "rig/telemetry/terminal_commands.hpp"
 #include "rig/session/case_switcher.hpp"
 #include "rig/session/frame_source.hpp"
+#include "rig/session/key_moments.hpp"
 #include "rig/session/snapshot_writer.hpp"
 #include "vitreo/render/render_thread.hpp"
 
@@ -72,7 +74,9 @@ void push_step_telemetry(const SimulationModel& model, bool stepped, std::uint64
   }
   const SurgicalControls& c = model.controls();
   out.push(telemetry::controls_item({c.vacuum_mmhg, c.cut_rate_cpm, c.reflux, c.laser_fire, c.pick_out, c.light_level, c.zoom,
-                                     model.laser().power_mw, model.laser().duration_ms},
+                                     model.laser().power_mw, model.laser().duration_ms, c.vitrectomy_travel, c.microscope_travel,
+                                     model.simulation().light().macula_dose_j_cm2,
+                                     model.simulation().options().light_dose_limit_j_cm2},
                                     step, t_s));
 }
 
@@ -220,6 +224,15 @@ SessionSummary run_session(const SessionConfig& config) {
     renderer = std::make_unique<render::RenderThread>(ro);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));
+  // Frames at the session's key moments (key_moments.hpp), when frames are written: physics takes
+  // the picture of the very step into key_view while it is free; the render service hands it to the
+  // render thread, which writes it beside the running frames.
+  const bool picture_moments = renderer && !config.png_dir.empty();
+  KeyMoments moments;
+  ViewSnapshot key_view;
+  KeyMoment key_moment;               // what key_view shows (written by physics before key_view_ready)
+  std::atomic<bool> key_view_ready{false};
+  FrameBuilder key_frames;
 
   std::vector<DeviceSpec> devices = config.devices;
   if (config.adapt_devices) config.adapt_devices(model.current_case(), devices);
@@ -268,6 +281,7 @@ SessionSummary run_session(const SessionConfig& config) {
       const int index = ready->index;
       model.stage(std::move(ready));
       case_over_step.store(-1, std::memory_order_release);  // a new (or reset) case runs
+      moments.reset();
       consume(case_input(index));
       if (switches < kMaxSwitchLog) switch_log[switches] = {k, index};
       ++switches;
@@ -302,7 +316,9 @@ SessionSummary run_session(const SessionConfig& config) {
     const bool stepped = !model.paused();  // paused: the world does not step, and has no new events
     const core::StepReport report = model.step();
     // The end of the case: announced once (console and telemetry), with the score that now stands.
+    bool case_ended = false;
     if (model.metrics().finished() && case_over_step.load(std::memory_order_relaxed) < 0) {
+      case_ended = true;
       case_over_complete.store(model.metrics().completed(), std::memory_order_relaxed);
       case_over_step.store(step, std::memory_order_release);
       push_scores(model, step, true, physics_out);
@@ -325,6 +341,14 @@ SessionSummary run_session(const SessionConfig& config) {
       if (e.kind == core::InstrumentEventKind::kLaserBurn) ++summary.burns;
     }
     push_step_telemetry(model, stepped, k, step, t_s, physics_out);
+    if (picture_moments && !key_view_ready.load(std::memory_order_acquire)) {
+      const std::optional<KeyMoment> m = moments.pending(stepped ? model.simulation().events() : kNoInstrumentEvents, case_ended);
+      if (m && capture_view(model, k, t_s, key_view)) {
+        key_moment = *m;
+        moments.pictured(*m);
+        key_view_ready.store(true, std::memory_order_release);
+      }
+    }
     if (renderer && (k % view_every == 0 || last)) {
       if (capture_view(model, k, t_s, views.write_slot())) views.publish();
     }
@@ -359,7 +383,16 @@ SessionSummary run_session(const SessionConfig& config) {
   harness.add_service("case-loader", std::chrono::milliseconds(5), [&] { switcher.service(!harness.physics_done()); });
   harness.add_service("snapshots", std::chrono::milliseconds(20), [&] { snapshots.service(); });
   std::uint64_t last_view = ~std::uint64_t{0};
+  // A key moment's picture goes first; it stays with physics' snapshot until the render thread took
+  // the previous one.
+  auto hand_over_moment = [&] {
+    if (!key_view_ready.load(std::memory_order_acquire)) return true;
+    if (!renderer->keep(key_frames.build(key_view), KeyMoments::file_prefix(config.png_dir, key_view.step, key_moment))) return false;
+    key_view_ready.store(false, std::memory_order_release);
+    return true;
+  };
   auto render_latest = [&] {
+    if (picture_moments) hand_over_moment();
     if (!views.update()) return;
     const ViewSnapshot& v = views.read_slot();
     if (v.step == last_view || !v.visuals) return;
@@ -386,7 +419,10 @@ SessionSummary run_session(const SessionConfig& config) {
   publisher.publish_receive_status("vitreo");  // the session's last word on what it received
   if (renderer) {
     render_latest();  // the final state, so the last frame shows where the session ended
+    // The last key moment (often the case's end) waits for the one before it to be written.
+    while (picture_moments && !hand_over_moment() && !renderer->error()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
     renderer->stop();
+    summary.key_moment_frames = renderer->kept_written();
     summary.frames_rendered = renderer->frames_rendered();
     summary.scenes_dropped = renderer->scenes_dropped();
     summary.pngs = renderer->pngs_written();
@@ -484,7 +520,7 @@ SessionSummary run_session(const SessionConfig& config) {
   return summary;
 }
 
-ReplaySummary replay_session(const std::string& path, const ModelConfig& base, bool real_time) {
+ReplaySummary replay_session(const std::string& path, const ModelConfig& base, const ReplayOptions& options) {
   const telemetry::Recording rec = telemetry::read_recording(path);
   // The cases as they were recorded: their texts are in the header, not read from scenes/.
   ModelConfig model_config = base;
@@ -517,19 +553,44 @@ ReplaySummary replay_session(const std::string& path, const ModelConfig& base, b
   const std::uint64_t total = through < 0 ? 0 : static_cast<std::uint64_t>(through) + 1;
   runtime::SimulatedClock sim;
   runtime::SteadyClock wall;
-  runtime::Clock& clock = real_time ? static_cast<runtime::Clock&>(wall) : static_cast<runtime::Clock&>(sim);
+  runtime::Clock& clock = options.real_time ? static_cast<runtime::Clock&>(wall) : static_cast<runtime::Clock&>(sim);
   runtime::LoopConfig loop_config;
   loop_config.period_ns = rec.header.step_period_us * 1000LL;
-  runtime::FixedStepLoop loop(clock, loop_config, [&](std::uint64_t k, double) {
-    cursor.feed_through_step(static_cast<std::int64_t>(k), [&](const telemetry::RecordedInput& in) {
+  // The physics telemetry again, when asked for: pumped from this thread (nothing here is real
+  // time), often enough that the source's ring never fills.
+  std::optional<telemetry::TelemetryPublisher> publisher;
+  telemetry::TelemetrySource* physics_out = nullptr;
+  if (!options.lcm_url.empty()) {
+    publisher.emplace(telemetry::PublisherConfig{options.lcm_url, 4096});
+    physics_out = &publisher->add_source("physics");
+  }
+  bool case_over_published = false;
+  runtime::FixedStepLoop loop(clock, loop_config, [&](std::uint64_t k, double t_s) {
+    const auto step = static_cast<std::int64_t>(k);
+    cursor.feed_through_step(step, [&](const telemetry::RecordedInput& in) {
+      if (std::holds_alternative<telemetry::CaseSwitch>(in.what)) case_over_published = false;  // a new (or reset) case runs
       model.apply(in);
       ++inputs;
     });
+    const bool stepped = !model.paused();
     model.step();
     ++steps;
+    if (!physics_out) return;
+    // What run_session's physics step publishes, in the same order. The session's final score only
+    // where the recording says the session ended there (a truncated one ends early: a running score).
+    const bool last = k + 1 == total;
+    const bool session_end = last && rec.end.has_value();
+    if (model.metrics().finished() && !case_over_published) {
+      case_over_published = true;
+      push_scores(model, step, true, *physics_out);
+    }
+    if (last || (options.score_every_steps > 0 && (k + 1) % options.score_every_steps == 0)) push_scores(model, step, session_end, *physics_out);
+    push_step_telemetry(model, stepped, k, step, t_s, *physics_out);
+    if (k % 64 == 0) publisher->pump();
   });
   const auto t0 = std::chrono::steady_clock::now();
   loop.run(total);
+  if (publisher) publisher->pump();
   ReplaySummary out;
   out.steps = steps;
   out.inputs = inputs;

@@ -91,6 +91,7 @@ struct SessionSummary {
   std::uint64_t frozen_steps = 0;          // steps during which an instrument was frozen (its tracker lost)
   std::uint64_t frames_rendered = 0, scenes_dropped = 0;
   std::vector<std::string> pngs;           // frames written
+  std::vector<std::string> key_moment_frames;  // frames of the key moments written (key_moments.hpp), in order
   std::string renderer;                    // EGL/GL context in use
   std::vector<std::string> displays;       // rig displays frames were scanned out to
   // The final score of the case the session ended in (core/metrics), as published on VITREO_SCORE,
@@ -134,13 +135,24 @@ struct ReplaySummary {
   std::vector<std::string> score_lines;  // the final score, as the live session published it
 };
 
+struct ReplayOptions {
+  bool real_time = false;  // paced by the wall clock; otherwise as fast as it goes (simulated clock)
+  // What physics published live, published again from the replay to this LCM URL (a log file:
+  // "file://PATH?mode=w"): instrument states, controls, events, score cards, criteria and totals —
+  // step for step the live session's, since the replay is. Not the device statuses, the timing or
+  // the command acknowledgements: a recording holds the inputs, not what the drivers and threads
+  // saw. Empty: nothing is published.
+  std::string lcm_url;
+  std::uint64_t score_every_steps = 1000;  // as SessionConfig::score_every_steps
+};
+
 // Replays a recording through the same model as fast as possible (simulated clock), or at real
-// time when `real_time` is set. The cases (their file and library texts, resolution overrides) come
+// time (ReplayOptions). The cases (their file and library texts, resolution overrides) come
 // from the recording, not from scenes/; `model` supplies the rest (pedal mapping, calibration, the
 // cache folder). Only what the recording can vouch for is replayed: a truncated or corrupted one
 // up to its last verified step (the verdict says so). Throws telemetry::RecordingError when it
 // cannot be replayed at all (no header, another format, a case list that does not decode, a start
 // state the case no longer rebuilds to).
-ReplaySummary replay_session(const std::string& recording_path, const ModelConfig& model, bool real_time = false);
+ReplaySummary replay_session(const std::string& recording_path, const ModelConfig& model, const ReplayOptions& options = {});
 
 }  // namespace vitreo::rig

@@ -1,8 +1,8 @@
 #pragma once
 // What physics copies for the picture at display rate (rig/session/frame_source.hpp): plain,
-// preallocated arrays, so a copy never allocates. A case's PreparedCase brings three of these sized
+// preallocated arrays, so a copy never allocates. A case's PreparedCase brings four of these sized
 // for its surfaces (made on the loader thread); physics swaps one into the triple buffer's write
-// slot whenever that slot was sized for an earlier case.
+// slot, or into the key moment's snapshot, whenever that one was sized for an earlier case.
 #include <cstdint>
 #include <vector>
 

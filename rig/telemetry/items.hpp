@@ -142,6 +142,8 @@ struct Controls {
   bool reflux = false, laser_fire = false, pick_out = false;
   double light_level = 0, zoom = 1;
   double laser_power_mw = 0, laser_duration_ms = 0;
+  double vitrectomy_pedal_travel[4] = {}, microscope_pedal_travel[4] = {};
+  double macula_light_dose_j_cm2 = 0, light_dose_limit_j_cm2 = 0;
 };
 
 using TelemetryItem = std::variant<InstrumentState, Event, PhysicsTiming, DeviceStatus, Score, Criteria, Totals, Controls>;

@@ -165,6 +165,12 @@ Controls controls_item(const ControlsState& c, std::int64_t step, double t_s) {
   o.zoom = c.zoom;
   o.laser_power_mw = c.laser_power_mw;
   o.laser_duration_ms = c.laser_duration_ms;
+  for (int i = 0; i < 4; ++i) {
+    o.vitrectomy_pedal_travel[i] = c.vitrectomy_pedal_travel ? c.vitrectomy_pedal_travel[i] : 0.0;
+    o.microscope_pedal_travel[i] = c.microscope_pedal_travel ? c.microscope_pedal_travel[i] : 0.0;
+  }
+  o.macula_light_dose_j_cm2 = c.macula_light_dose_j_cm2;
+  o.light_dose_limit_j_cm2 = c.light_dose_limit_j_cm2;
   return o;
 }
 
@@ -441,6 +447,12 @@ vitreo_lcm::controls_t to_lcm(const Controls& v, std::int64_t utime_us) {
   m.zoom = v.zoom;
   m.laser_power_mw = v.laser_power_mw;
   m.laser_duration_ms = v.laser_duration_ms;
+  for (int i = 0; i < 4; ++i) {
+    m.vitrectomy_pedal_travel[i] = v.vitrectomy_pedal_travel[i];
+    m.microscope_pedal_travel[i] = v.microscope_pedal_travel[i];
+  }
+  m.macula_light_dose_j_cm2 = v.macula_light_dose_j_cm2;
+  m.light_dose_limit_j_cm2 = v.light_dose_limit_j_cm2;
   return m;
 }
 

@@ -85,6 +85,9 @@ struct ControlsState {
   bool reflux = false, laser_fire = false, pick_out = false;
   double light_level = 0, zoom = 1;
   double laser_power_mw = 0, laser_duration_ms = 0;
+  const double* vitrectomy_pedal_travel = nullptr;  // 4 axes each; null: all 0
+  const double* microscope_pedal_travel = nullptr;
+  double macula_light_dose_j_cm2 = 0, light_dose_limit_j_cm2 = 0;
 };
 Controls controls_item(const ControlsState& c, std::int64_t step, double t_s);
 

@@ -39,6 +39,23 @@ void RenderThread::request_png(std::string path_prefix) {
   png_prefix_ = std::move(path_prefix);
 }
 
+bool RenderThread::keep(FrameScene scene, std::string path_prefix) {
+  {
+    std::lock_guard lock(mutex_);
+    if (kept_scene_) return false;
+    kept_scene_ = std::move(scene);
+    kept_prefix_ = std::move(path_prefix);
+  }
+  wake_.fetch_add(1, std::memory_order_release);
+  wake_.notify_one();
+  return true;
+}
+
+std::vector<std::string> RenderThread::kept_written() const {
+  std::lock_guard lock(mutex_);
+  return kept_written_;
+}
+
 void RenderThread::stop() {
   if (!thread_.joinable()) return;
   stop_.store(true, std::memory_order_release);
@@ -120,10 +137,30 @@ void RenderThread::run(std::promise<void>& started) {
   StereoFrame frame;
   Image instructor;
   const bool instructor_wanted = !options_.instructor_ring_name.empty() || !options_.png_dir.empty();
+  // A kept scene (keep()) gets a frame and an instructor view of its own: the running frame, the
+  // last one of the run, stays the newest published scene's.
+  auto render_kept = [&] {
+    std::optional<FrameScene> kept;
+    std::string prefix;
+    {
+      std::lock_guard lock(mutex_);
+      if (!kept_scene_) return false;
+      kept.swap(kept_scene_);
+      prefix.swap(kept_prefix_);
+    }
+    StereoFrame kept_frame;
+    renderer->render(*kept, kept_frame);
+    const Image view = compose_instructor_view(kept_frame, kept->instructor ? *kept->instructor : InstructorOverlay{});
+    write_stereo_pngs(prefix, kept_frame, &view);
+    std::lock_guard lock(mutex_);
+    kept_written_.push_back(prefix);
+    return true;
+  };
   try {
     for (;;) {
       const std::uint64_t wake = wake_.load(std::memory_order_acquire);
       const bool stopping = stop_.load(std::memory_order_acquire);
+      if (render_kept()) continue;
       const FrameScene* scene = mailbox_.take();
       if (scene == nullptr) {
         if (stopping) break;

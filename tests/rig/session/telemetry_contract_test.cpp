@@ -443,6 +443,7 @@ TEST(TelemetryContract, ScoresControlsAcksAndReceiveStatusAsDocumented) {
 
   const auto controls = f.telemetry.decoded<vitreo_lcm::controls_t>(telemetry::kChanControls);
   ASSERT_EQ(controls.size(), 375u) << "every 4th step of 1500";
+  double max_travel = 0.0, last_dose = 0.0;
   for (const auto& c : controls) {
     EXPECT_EQ(c.step % 4, 0);
     EXPECT_DOUBLE_EQ(c.t_s, static_cast<double>(c.step) * 1e-3);
@@ -452,7 +453,22 @@ TEST(TelemetryContract, ScoresControlsAcksAndReceiveStatusAsDocumented) {
     EXPECT_GT(c.zoom, 0.0);
     EXPECT_EQ(c.laser_power_mw, f.config.model.laser.power_mw);
     EXPECT_EQ(c.laser_duration_ms, f.config.model.laser.duration_ms);
+    // The travel that set the vacuum: the default mapping's vacuum axis 0 over 650 mmHg
+    // (rig/input/controls.hpp), on pedals without a calibration.
+    for (int a = 0; a < 4; ++a) {
+      EXPECT_TRUE(c.vitrectomy_pedal_travel[a] >= 0 && c.vitrectomy_pedal_travel[a] <= 1);
+      EXPECT_TRUE(c.microscope_pedal_travel[a] >= 0 && c.microscope_pedal_travel[a] <= 1);
+    }
+    EXPECT_NEAR(c.vacuum_mmhg, 650.0 * c.vitrectomy_pedal_travel[0], 1e-9);
+    max_travel = std::max(max_travel, c.vitrectomy_pedal_travel[0]);
+    EXPECT_GE(c.macula_light_dose_j_cm2, last_dose) << "a dose only accumulates";
+    last_dose = c.macula_light_dose_j_cm2;
+    EXPECT_EQ(c.light_dose_limit_j_cm2, 10.0) << "core InstrumentSceneOptions' default limit";
   }
+  // The script's pedal rises to 0.7 of its travel at 0.4 s and back to 0 at 1.2 s (sampled at 250 Hz,
+  // carried in 16 bits).
+  EXPECT_GT(max_travel, 0.6);
+  EXPECT_LE(max_travel, 0.7 + 1e-4);
 
   // The terminal's commands: pause accepted, a second pause right after its ack refused, resume, zoom.
   const auto acks = f.telemetry.decoded<vitreo_lcm::command_ack_t>(telemetry::kChanCommandAck);

@@ -220,6 +220,12 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   k.zoom = 1.5;
   k.laser_power_mw = 350;
   k.laser_duration_ms = 120;
+  for (int a = 0; a < 4; ++a) {
+    k.vitrectomy_pedal_travel[a] = 0.1 * (a + 1);
+    k.microscope_pedal_travel[a] = 0.05 * (a + 1);
+  }
+  k.macula_light_dose_j_cm2 = 2.5;
+  k.light_dose_limit_j_cm2 = 10;
   ASSERT_TRUE(physics.push(k));
 
   EXPECT_EQ(pub.pump(), 5u);
@@ -291,6 +297,12 @@ TEST(TelemetryPublisher, MemqRoundTripOfTheDebriefItems) {
   EXPECT_DOUBLE_EQ(kg.zoom, 1.5);
   EXPECT_DOUBLE_EQ(kg.laser_power_mw, 350);
   EXPECT_DOUBLE_EQ(kg.laser_duration_ms, 120);
+  for (int a = 0; a < 4; ++a) {
+    EXPECT_DOUBLE_EQ(kg.vitrectomy_pedal_travel[a], 0.1 * (a + 1));
+    EXPECT_DOUBLE_EQ(kg.microscope_pedal_travel[a], 0.05 * (a + 1));
+  }
+  EXPECT_DOUBLE_EQ(kg.macula_light_dose_j_cm2, 2.5);
+  EXPECT_DOUBLE_EQ(kg.light_dose_limit_j_cm2, 10);
   EXPECT_GT(kg.utime_us, 0);
 }
 

@@ -60,8 +60,16 @@ class RenderThread {
   /// Asks for the next rendered frame to be written as PNGs: "<prefix>_left.png", "_right.png",
   /// "_stereo.png" (side by side). Returns immediately.
   void request_png(std::string path_prefix);
-  /// Stops rendering; returns after the thread has finished (the last published scene is rendered
-  /// first if it had not been).
+  /// A picture that must not be skipped (a frame at a key moment of the session): `scene` is
+  /// rendered before the newest published one and written as "<prefix>_left.png", "_right.png",
+  /// "_stereo.png" and "_instructor.png" (the instructor's view of it). One such scene waits at a
+  /// time: false (and nothing taken) while the previous one has not been rendered yet. Not for the
+  /// physics thread: it locks a mutex the render thread holds briefly.
+  bool keep(FrameScene scene, std::string path_prefix);
+  /// Prefixes of the kept scenes written so far (keep()).
+  std::vector<std::string> kept_written() const;
+  /// Stops rendering; returns after the thread has finished (the last published scene, and a kept
+  /// one still waiting, are rendered first if they had not been).
   void stop();
 
   std::uint64_t frames_rendered() const { return frames_.load(std::memory_order_acquire); }
@@ -86,8 +94,11 @@ class RenderThread {
   std::atomic<std::uint64_t> wake_{0};  // bumped by publish()/stop(); the render thread sleeps on it
   std::atomic<std::uint64_t> frames_{0};
   std::atomic<std::uint64_t> last_step_{0};
-  mutable std::mutex mutex_;  // guards png_prefix_ and error_ (never taken by publish())
+  mutable std::mutex mutex_;  // guards png_prefix_, the kept scene and error_ (never taken by publish())
   std::string png_prefix_;
+  std::optional<FrameScene> kept_scene_;
+  std::string kept_prefix_;
+  std::vector<std::string> kept_written_;
   std::optional<std::string> error_;
   std::vector<std::string> pngs_written_;
   std::string context_description_;
