@@ -38,6 +38,14 @@ std::string report_html(const PageInputs& in) {
   fill(page, "@GENERATED@", html_text(in.generated));
   fill(page, "@FUNDUS_NAME@", html_text(in.final_png_name.empty() ? "no instructor frame in the session folder" : in.final_png_name));
   fill(page, "@FUNDUS_SRC@", in.final_png.empty() ? std::string() : "data:image/png;base64," + base64_encode(in.final_png));
+  std::string moments;
+  for (const KeyMomentFrame& m : in.key_moments) {
+    moments += "<figure><img class=\"fundus\" alt=\"" + html_text(m.what) + "\" src=\"data:image/png;base64," + base64_encode(m.png) +
+               "\"><figcaption>step " + std::to_string(m.step) + ": <b>" + html_text(m.what) + "</b> (" + html_text(m.file) +
+               ")</figcaption></figure>";
+  }
+  if (moments.empty()) moments = "<p class=\"meta\">no pictures of key moments in the session folder (the session rendered no frames, or nothing went wrong and the case did not end)</p>";
+  fill(page, "<!--@KEY_MOMENTS@-->", moments);
   fill(page, "@COMPARE_LABEL@", html_text(in.compare_label));
   fill(page, "@COMPARE_FUNDUS_SRC@", in.compare_png.empty() ? std::string() : "data:image/png;base64," + base64_encode(in.compare_png));
   fill(page, "/*@CHARTJS@*/", assets::chartjs());

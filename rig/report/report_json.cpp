@@ -297,7 +297,8 @@ void write_array(JsonWriter& j, const std::vector<double>& v, const std::vector<
 
 }  // namespace
 
-std::string report_json(const SessionLog& log, const Survey* survey, const std::string& survey_problem, const std::string& trainee) {
+std::string report_json(const SessionLog& log, const Survey* survey, const std::string& survey_problem, const std::string& trainee,
+                        const CaseAnatomy* anatomy) {
   JsonWriter j;
   const ScoreRecord* score = final_or_last(log.scores);
   const CriteriaRecord* criteria = final_or_last(log.criteria);
@@ -447,6 +448,34 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
   // Per hand (tracker): the tip's path inside the eye with its speed, the retina force it felt.
   std::map<int, std::vector<const TipSample*>> hands;
   for (const auto& s : log.tips) hands[s.instrument].push_back(&s);
+  // The case's anatomy under the tip paths (from the session's recording).
+  j.key("anatomy");
+  if (anatomy) {
+    j.begin_object();
+    j.key("case").value(anatomy->case_id);
+    j.key("units").begin_object();
+    j.key("x").value("mm");
+    j.key("y").value("mm");
+    j.end_object();
+    j.key("outlines").begin_array();
+    for (const FundusOutline& o : anatomy->outlines) {
+      j.begin_object();
+      j.key("name").value(o.name);
+      j.key("kind").value(o.kind);
+      std::vector<std::size_t> all(o.x_mm.size());
+      for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+      j.key("x");
+      write_array(j, o.x_mm, all);
+      j.key("y");
+      write_array(j, o.y_mm, all);
+      j.end_object();
+    }
+    j.end_array();
+    j.end_object();
+  } else {
+    j.value(nullptr);
+  }
+
   j.key("hands").begin_array();
   for (const auto& [id, samples] : hands) {
     std::vector<double> t, x, y, z, speed, force, actuation;
@@ -512,14 +541,22 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
   }
   j.end_array();
 
-  // The pedals' controls over time.
+  // The pedals' controls over time, the travel that set them, the macula's light dose.
   {
-    std::vector<double> t, vac, cut, light;
+    std::vector<double> t, vac, cut, light, dose;
+    std::vector<double> vit_travel[4], mic_travel[4];
+    double dose_limit = 0.0;
     for (const auto& c : log.controls) {
       t.push_back(c.t_s);
       vac.push_back(c.vacuum_mmhg);
       cut.push_back(c.cut_rate_cpm);
       light.push_back(c.light_level);
+      dose.push_back(c.macula_dose_j_cm2);
+      dose_limit = c.dose_limit_j_cm2;
+      for (int a = 0; a < 4; ++a) {
+        vit_travel[a].push_back(c.vitrectomy_travel[a]);
+        mic_travel[a].push_back(c.microscope_travel[a]);
+      }
     }
     const auto idx = decimate(t.size(), kMaxSeriesPoints);
     j.key("controls").begin_object();
@@ -528,6 +565,10 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     j.key("vacuum").value("mmHg");
     j.key("cut_rate").value("cuts/min");
     j.key("light_level").value("share (0..1)");
+    j.key("vitrectomy_pedal_travel").value("share of each axis' travel (0..1)");
+    j.key("microscope_pedal_travel").value("share of each axis' travel (0..1)");
+    j.key("macula_light_dose").value("J/cm2");
+    j.key("light_dose_limit").value("J/cm2");
     j.end_object();
     j.key("t");
     write_array(j, t, idx);
@@ -537,6 +578,14 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     write_array(j, cut, idx);
     j.key("light_level");
     write_array(j, light, idx);
+    for (const auto& [name, axes] : {std::pair{"vitrectomy_pedal_travel", &vit_travel}, std::pair{"microscope_pedal_travel", &mic_travel}}) {
+      j.key(name).begin_array();
+      for (const auto& axis : *axes) write_array(j, axis, idx);
+      j.end_array();
+    }
+    j.key("macula_light_dose");
+    write_array(j, dose, idx);
+    j.key("light_dose_limit").value(dose_limit);
     j.end_object();
   }
 

@@ -178,6 +178,12 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     c.zoom = m.zoom;
     c.reflux = m.reflux;
     c.laser_fire = m.laser_fire;
+    for (int a = 0; a < 4; ++a) {
+      c.vitrectomy_travel[a] = m.vitrectomy_pedal_travel[a];
+      c.microscope_travel[a] = m.microscope_pedal_travel[a];
+    }
+    c.macula_dose_j_cm2 = m.macula_light_dose_j_cm2;
+    c.dose_limit_j_cm2 = m.light_dose_limit_j_cm2;
     log.latest_t_s = std::max(log.latest_t_s, c.t_s);
     log.controls.push_back(c);
   } else if (ev.channel == t::kChanDeviceStatus) {

@@ -89,6 +89,8 @@ struct ControlsRecord {
   double t_s = 0;
   double vacuum_mmhg = 0, cut_rate_cpm = 0, light_level = 0, zoom = 1;
   bool reflux = false, laser_fire = false;
+  double vitrectomy_travel[4] = {}, microscope_travel[4] = {};  // the pedals' axes, 0..1
+  double macula_dose_j_cm2 = 0, dose_limit_j_cm2 = 0;
 };
 
 // A spell in which a device was not simply working: "lost" (link gone), "stuck" (bit-identical

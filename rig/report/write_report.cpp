@@ -6,6 +6,9 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <string_view>
+#include <utility>
+#include <vector>
 #include <stdexcept>
 
 #include "rig/report/atomic_file.hpp"
@@ -44,6 +47,26 @@ fs::path last_instructor_frame(const fs::path& dir) {
   return best;
 }
 
+// The pictures of the session's key moments (rig/session/key_moments.hpp), in step order: frames
+// named moment_<9-digit step>_<slug>_instructor.png. A name that does not parse is left out.
+std::vector<std::pair<std::uint64_t, fs::path>> key_moment_frames(const fs::path& dir) {
+  std::vector<std::pair<std::uint64_t, fs::path>> found;
+  std::error_code ec;
+  if (!fs::is_directory(dir / "frames", ec)) return found;
+  constexpr std::string_view kPrefix = "moment_", kSuffix = "_instructor.png";
+  for (const auto& e : fs::directory_iterator(dir / "frames", ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.starts_with(kPrefix) || !name.ends_with(kSuffix) || name.size() < kPrefix.size() + 11 + kSuffix.size() ||
+        !e.is_regular_file(ec))
+      continue;
+    const std::string digits = name.substr(kPrefix.size(), 9);
+    if (name[kPrefix.size() + 9] != '_' || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    found.emplace_back(std::stoull(digits), e.path());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + p.string());
@@ -60,7 +83,8 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
   std::error_code ec;
   if (!fs::exists(log_path, ec))
     throw std::runtime_error("no telemetry log at " + log_path.string() + " (a session folder is what `vitreo --out DIR` wrote)");
-  const SessionLog log = read_session_log(log_path.string());
+  SessionLog log = read_session_log(log_path.string());
+  if (!options.log_origin.empty()) log.notice = log.notice.empty() ? options.log_origin : options.log_origin + "; " + log.notice;
   // The survey filled in after the session (the page's form saves it as DIR/survey.json).
   std::optional<Survey> survey;
   std::string survey_problem;
@@ -71,7 +95,15 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
       survey_problem = e.what();
     }
   }
-  const std::string json = report_json(log, survey ? &*survey : nullptr, survey_problem, read_trainee(session_dir));
+  // The case's anatomy under the tip paths, from the case files the recording carries.
+  std::optional<CaseAnatomy> anatomy;
+  std::string anatomy_problem;
+  if (const fs::path rec = dir / "session.lcmlog"; fs::is_regular_file(rec, ec)) {
+    std::string case_id;
+    for (const auto& sc : log.scores) case_id = sc.case_id;
+    anatomy = anatomy_from_recording(rec.string(), case_id, anatomy_problem);
+  }
+  const std::string json = report_json(log, survey ? &*survey : nullptr, survey_problem, read_trainee(session_dir), anatomy ? &*anatomy : nullptr);
 
   PageInputs page;
   page.report_json = json;
@@ -82,6 +114,16 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
     page.final_png_name = "frames/" + frame.filename().string();
   }
   page.final_png = png;
+  for (const auto& [step, path] : key_moment_frames(dir)) {
+    KeyMomentFrame m;
+    const std::string name = path.filename().string();
+    m.png = read_file(path);
+    m.file = "frames/" + name;
+    m.step = step;
+    m.what = name.substr(17, name.size() - 17 - std::string_view("_instructor.png").size());  // after "moment_<9 digits>_"
+    std::replace(m.what.begin(), m.what.end(), '-', ' ');
+    page.key_moments.push_back(std::move(m));
+  }
   const std::string html = report_html(page);
 
   const fs::path out = options.out_dir.empty() ? dir : fs::path(options.out_dir);
@@ -108,6 +150,7 @@ WrittenReport write_report(const std::string& session_dir, const ReportOptions& 
 
   if (!log.notice.empty()) r.notices.push_back(log.notice);
   if (!survey_problem.empty()) r.notices.push_back("survey.json not shown: " + survey_problem);
+  if (!anatomy_problem.empty()) r.notices.push_back("the case's anatomy is not drawn under the tip paths: " + anatomy_problem);
   if (survey) r.survey_rating = survey->rating;
   if (log.messages_skipped > 0) r.notices.push_back(std::to_string(log.messages_skipped) + " messages did not decode");
   const ScoreRecord* score = log.scores.empty() ? nullptr : &log.scores.back();

@@ -24,6 +24,9 @@ struct ReportOptions {
   // Another session folder (e.g. the case's expert script run) to show side by side: also writes
   // OUT/compare.html, this session (A) against that one (B).
   std::string compare_dir;
+  // Where the log came from when it is not what the session itself wrote (vitreo-report regenerates
+  // a missing one from the recording): shown as a notice on the page and in the JSON.
+  std::string log_origin;
 };
 
 // Throws std::runtime_error with a reason an instructor can act on (no log, nothing readable,

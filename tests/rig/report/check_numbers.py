@@ -15,7 +15,7 @@ import sys
 from lcm_log import read_log
 
 sys.path.insert(0, sys.argv[1])
-from vitreo_lcm import (criteria_t, event_t, instrument_state_t, score_t,  # noqa: E402
+from vitreo_lcm import (controls_t, criteria_t, event_t, instrument_state_t, score_t,  # noqa: E402
                         session_totals_t)
 
 session = sys.argv[2]
@@ -36,6 +36,7 @@ criteria = [criteria_t.decode(b) for b in by_chan.get("VITREO_CRITERIA", [])]
 totals = [session_totals_t.decode(b) for b in by_chan.get("VITREO_TOTALS", [])]
 states = [instrument_state_t.decode(b) for b in by_chan.get("VITREO_INSTRUMENT_STATE", [])]
 evts = [event_t.decode(b) for b in by_chan.get("VITREO_EVENT", [])]
+ctrls = [controls_t.decode(b) for b in by_chan.get("VITREO_CONTROLS", [])]
 check("the log has score cards, criteria and totals", scores and criteria and totals, "missing")
 
 
@@ -98,6 +99,19 @@ for hand in report["hands"]:
           f'{hand["sampled_path_length"]["value"]} vs {path}')
     peak = max((s.retina_force_un for s in own), default=0.0)
     check(f"hand {hand['tracker']} peak force", hand["peak_retina_force"]["value"] == peak)
+
+# The pedals' travel and the macula's light dose: every sample of the log (the fixture's 2000 are
+# under the report's 2500-point thinning), axis by axis. (The fixture's forceps peel uses no pedal:
+# the telemetry contract test checks the travel of a pressed pedal against the vacuum it set.)
+c = report["controls"]
+check("controls samples", c["t"] == [m.t_s for m in ctrls], f'{len(c["t"])} vs {len(ctrls)}')
+for name, attr in [("vitrectomy_pedal_travel", "vitrectomy_pedal_travel"), ("microscope_pedal_travel", "microscope_pedal_travel")]:
+    check(f"{name} axes", len(c[name]) == 4, len(c[name]))
+    for a in range(4):
+        check(f"{name} axis {a}", c[name][a] == [getattr(m, attr)[a] for m in ctrls])
+check("macular light dose", c["macula_light_dose"] == [m.macula_light_dose_j_cm2 for m in ctrls])
+check("the dose only accumulates", all(b >= a for a, b in zip(c["macula_light_dose"], c["macula_light_dose"][1:])))
+check("light dose limit", c["light_dose_limit"] == ctrls[-1].light_dose_limit_j_cm2 and c["light_dose_limit"] > 0, c["light_dose_limit"])
 
 # The main job's console summary (from the in-memory metrics) against the report.
 summary = open(f"{session}/summary.txt").read()

@@ -24,7 +24,16 @@ grep -q '"trainee":"fellow-07"' "$session/report.json"   # vitreo --trainee, kep
 # The embedded fundus is the last instructor frame.
 last=$(ls "$session"/frames/step_*_instructor.png | sort | tail -1)
 grep -q "frames/$(basename "$last")" "$work/a/report.html"
-grep -o 'data:image/png;base64,[^"]*' "$work/a/report.html" | cut -d, -f2 | base64 -d | cmp - "$last"
+grep -o 'id="final-fundus" alt="final fundus" src="data:image/png;base64,[^"]*' "$work/a/report.html" | cut -d, -f2 | base64 -d | cmp - "$last"
+# So are the key moments' pictures, in step order.
+moments=$(ls "$session"/frames/moment_*_instructor.png | sort)
+[ -n "$moments" ] || { echo "the fixture session pictured no key moment"; exit 1; }
+i=0
+for m in $moments; do
+  i=$((i + 1))
+  grep -o '<figure><img class="fundus" alt="[^"]*" src="data:image/png;base64,[^"]*' "$work/a/report.html" | sed -n "${i}p" | cut -d, -f2 | base64 -d | cmp - "$m"
+  grep -q "(frames/$(basename "$m"))" "$work/a/report.html"
+done
 # Nothing in the page reaches for the network.
 if grep -qiE '(src|href)="(https?:)?//' "$work/a/report.html"; then echo "the page references a remote resource"; exit 1; fi
 echo "deterministic: json $(stat -c %s "$work/a/report.json") bytes, html $(stat -c %s "$work/a/report.html") bytes"
