@@ -631,6 +631,7 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
     j.key("device_id").value(d.device_id);
     j.key("name").value(d.name);
     j.key("transport").value(d.transport);
+    j.key("calibration").value(d.calibration);
     j.key("state").value(device_state_name(d.state));
     j.key("detail").value(d.detail);
     j.key("status_messages").value(static_cast<std::int64_t>(d.status_messages));

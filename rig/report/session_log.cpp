@@ -49,6 +49,7 @@ void take_device_status(const vitreo_lcm::device_status_t& m, SessionLog& log) {
   ++d.status_messages;
   d.name = m.name;
   d.transport = m.transport;
+  d.calibration = m.calibration;
   d.state = m.state;
   d.detail = m.detail;
   d.frames_rx = m.frames_rx;

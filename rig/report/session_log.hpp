@@ -110,6 +110,7 @@ struct DeviceSpell {
 struct DeviceRecord {
   std::int32_t device_id = 0;
   std::string name, transport;
+  std::string calibration;  // the calibration in force for it (its last status), "" uncalibrated
   int state = 0;  // device_status_t::STATE_* of the last status
   std::string detail;
   std::uint64_t status_messages = 0;

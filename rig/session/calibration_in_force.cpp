@@ -47,10 +47,13 @@ CalibrationLoad load_calibration(const std::string& path, std::vector<DeviceSpec
   load.file = apply_calibration(*f.text, path, candidate);
   std::vector<calibration::DeviceSerial> rig;
   std::vector<DeviceSpec> pinned = devices;
+  const std::string id = calibration_id(load.file);
   for (DeviceSpec& d : pinned) {
     std::uint32_t serial = d.expected_serial;
     for (const calibration::DeviceSerial& s : load.file.devices) {
-      if (s.name == d.name && serial == 0) {
+      if (s.name != d.name) continue;
+      d.calibration = id;
+      if (serial == 0) {
         serial = d.expected_serial = s.serial;
         load.notes.push_back(d.name + " must announce serial " + std::to_string(s.serial) + " (the calibrated unit)");
       }

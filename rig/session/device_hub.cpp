@@ -285,7 +285,8 @@ void DeviceHub::publish_status(std::uint64_t now_us) {
     measured.latency_p99_us = w.latency_p99_us;
     measured.reader_stalls = reader_stalls();
     measured.reader_stall_max_ms = static_cast<float>(reader_stall_max_us()) * 1e-3f;
-    status_out_->push(telemetry::device_status_item(d->spec.device_id, d->spec.name, d->driver->uri(), session, now_us, measured));
+    status_out_->push(
+        telemetry::device_status_item(d->spec.device_id, d->spec.name, d->driver->uri(), session, now_us, measured, d->spec.calibration));
   }
 }
 

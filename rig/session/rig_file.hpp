@@ -57,6 +57,9 @@ struct DeviceSpec {
   // sim: URIs: the emulator's script text (drivers/sim/emulator.hpp); empty: decided by the caller
   // (the main job's scripted session), else the built-in script of the device's kind.
   std::string sim_script;
+  // The calibration in force for this device (calibration_in_force.hpp's calibration_id), set when
+  // a calibration file that covers it is loaded; empty: uncalibrated. Published in its status.
+  std::string calibration = {};
 };
 
 struct RigFile {

@@ -79,6 +79,7 @@ struct DeviceStatus {
   bool stuck = false;
   std::int64_t stuck_episodes = 0, stuck_samples = 0, range_rejected = 0, timestamp_jumps = 0, reader_stalls = 0;
   float reader_stall_max_ms = 0;
+  char calibration[64] = {};
 };
 
 struct Score {

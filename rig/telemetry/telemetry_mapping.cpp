@@ -206,7 +206,8 @@ std::int8_t device_state_code(drivers::LinkState s, bool refused) {
 }
 
 DeviceStatus device_status_item(std::int32_t device_id, std::string_view name, std::string_view transport,
-                                const drivers::DeviceSession& session, std::uint64_t now_us, const DeviceMeasured& measured) {
+                                const drivers::DeviceSession& session, std::uint64_t now_us, const DeviceMeasured& measured,
+                                std::string_view calibration) {
   const drivers::LinkStats& st = session.stats();
   const drivers::LinkState link = session.state();
   const bool refused = !session.refusal().empty();
@@ -214,6 +215,7 @@ DeviceStatus device_status_item(std::int32_t device_id, std::string_view name, s
   s.device_id = device_id;
   copy_text(s.name, name);
   copy_text(s.transport, transport);
+  copy_text(s.calibration, calibration);
   s.state = device_state_code(link, refused);
   const std::uint64_t last = session.last_sample_us();
   s.last_sample_age_us = last == 0 ? -1 : static_cast<std::int64_t>(now_us >= last ? now_us - last : 0);
@@ -321,6 +323,7 @@ vitreo_lcm::device_status_t to_lcm(const DeviceStatus& v, std::int64_t utime_us)
   m.transport = text(v.transport);
   m.state = v.state;
   m.detail = text(v.detail);
+  m.calibration = text(v.calibration);
   m.frames_rx = v.frames_rx;
   m.frames_tx = v.frames_tx;
   m.bytes_rx = v.bytes_rx;

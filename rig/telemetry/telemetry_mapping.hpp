@@ -105,7 +105,8 @@ struct DeviceMeasured {
   float reader_stall_max_ms = 0;
 };
 DeviceStatus device_status_item(std::int32_t device_id, std::string_view name, std::string_view transport,
-                                const drivers::DeviceSession& session, std::uint64_t now_us, const DeviceMeasured& measured);
+                                const drivers::DeviceSession& session, std::uint64_t now_us, const DeviceMeasured& measured,
+                                std::string_view calibration = {});
 // device_status_t's lifecycle code of a link state (a refused device is STATE_ERROR whatever its
 // link does).
 std::int8_t device_state_code(drivers::LinkState s, bool refused);

@@ -17,6 +17,14 @@
 #include "rig/session/calibration_in_force.hpp"
 #include "rig/session/device_hub.hpp"
 #include "rig/session/device_inputs.hpp"
+#include "rig/session/rig_session.hpp"
+#include "rig/scene_io/case_loader.hpp"
+#include "rig/telemetry/channels.hpp"
+#include "rig/telemetry/recording.hpp"
+#include "vitreo_lcm/device_status_t.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+#include <map>
 
 namespace vitreo::rig {
 namespace {
@@ -252,6 +260,53 @@ TEST_F(CalibrationEndToEnd, ADeviceThatStopsMidwayFailsAndKeepsThePreviousCalibr
   std::ifstream after_f(previous);
   const std::string after((std::istreambuf_iterator<char>(after_f)), std::istreambuf_iterator<char>());
   EXPECT_EQ(after, before);
+}
+
+// Telemetry says which calibration is in force: a short session of the calibrated simulated rig
+// (its rig file's devices, the file vitreo-calibrate just wrote) publishes, in every device's
+// status, the id of that file; the same session's recording carries the file itself.
+TEST_F(CalibrationEndToEnd, TheSessionsTelemetrySaysWhichCalibrationIsInForce) {
+  ASSERT_EQ(run_.status, 0) << run_.output;
+  RigFile rig = read_rig_file(kSource + "/rig/config/sim-calibration.toml");
+  SessionConfig config;
+  config.model.cases.push_back(scene_io::read_case_text(kSource + "/scenes/exercise_pull_tissue.toml"));
+  config.model.load.retina_vertices = 1500;
+  config.model.load.textures = false;
+  config.model.load.cache_dir = (dir_ / "case-cache").string();
+  const CalibrationLoad load = load_calibration(file_, rig.devices, config.model, 30.0, ::time(nullptr));
+  config.devices = rig.devices;
+  config.device_mode = HubMode::lockstep;
+  config.unpaced = true;
+  config.steps = 600;
+  const std::string log_path = (dir_ / "calibrated-telemetry.lcmlog").string();
+  config.lcm_url = "file://" + log_path + "?mode=w";
+  config.record_path = (dir_ / "calibrated-session.lcmlog").string();
+  config.command_echo = nullptr;
+  const SessionSummary summary = run_session(config);
+  ASSERT_EQ(summary.steps, 600u);
+
+  const std::string id = calibration_id(load.file);
+  ASSERT_NE(id, "");
+  std::map<std::string, std::string> last;  // device → the calibration its last status named
+  int statuses = 0;
+  lcm::LogFile log(log_path, "r");
+  ASSERT_TRUE(log.good());
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev != nullptr; ev = log.readNextEvent()) {
+    if (ev->channel != telemetry::kChanDeviceStatus) continue;
+    vitreo_lcm::device_status_t m;
+    ASSERT_EQ(m.decode(ev->data, 0, ev->datalen), ev->datalen);
+    last[m.name] = m.calibration;
+    ++statuses;
+    EXPECT_EQ(m.calibration, id) << m.name << ": every status names the calibration in force";
+  }
+  EXPECT_GE(statuses, 3);
+  for (const auto& d : rig.devices) EXPECT_EQ(last[d.name], id) << d.name;
+  // The recording's case list holds the calibration file's text (a replay maps as the session did).
+  const telemetry::Recording rec = telemetry::read_recording(config.record_path);
+  ModelConfig replayed;
+  decode_case_list(rec.header.config_text, replayed);
+  EXPECT_EQ(replayed.calibration_text, config.model.calibration_text);
+  std::printf("calibration in force, as telemetry names it: %s (%d statuses)\n", id.c_str(), statuses);
 }
 
 }  // namespace

@@ -243,6 +243,7 @@ TEST(TelemetryContract, DeviceStatusFillsEveryFieldAndCountsRejectionsByCause) {
       EXPECT_EQ(s.transport.rfind("sim:", 0), 0u) << "the device's URI: " << s.transport;
       EXPECT_TRUE(s.state >= M::STATE_INACTIVE && s.state <= M::STATE_LOST) << int{s.state};
       EXPECT_NE(int{s.state}, int{M::STATE_ERROR}) << "no device here is refused: " << s.detail;
+      EXPECT_EQ(s.calibration, "") << "this rig runs uncalibrated (the calibration tests check a calibrated one)";
       // detail: empty exactly when the device streams without a fault.
       const bool healthy = s.state == M::STATE_ACTIVE && !s.stuck && s.detail.rfind("stale", 0) != 0;
       if (s.state == M::STATE_ACTIVE && !s.stuck && s.last_sample_age_us < 20'000) {

@@ -36,12 +36,13 @@ vp_message device_info(std::uint8_t seq, std::uint8_t type, std::uint8_t major, 
 }
 
 // Publishes the session's status through LCM and returns it decoded.
-M published(const drivers::DeviceSession& s, std::uint64_t now_us, telemetry::DeviceMeasured measured = {}) {
+M published(const drivers::DeviceSession& s, std::uint64_t now_us, telemetry::DeviceMeasured measured = {},
+            std::string_view calibration = {}) {
   telemetry::TelemetryPublisher pub(telemetry::PublisherConfig{"memq://", 16});
   telemetry::TelemetrySource& src = pub.add_source("devices");
   Last last;
   auto sub = telemetry::subscribe_to<M>(pub.lcm(), telemetry::kChanDeviceStatus, &last);
-  src.push(telemetry::device_status_item(7, "tracker-0", "serial:/dev/ttyACM0", s, now_us, measured));
+  src.push(telemetry::device_status_item(7, "tracker-0", "serial:/dev/ttyACM0", s, now_us, measured, calibration));
   pub.pump();
   while (pub.handle_incoming() > 0) {
   }
@@ -155,6 +156,10 @@ TEST(DeviceStatusMapping, StaleIsActiveWithItsReasonAndLostSaysWhy) {
   const M lost = published(s, 40'000);
   EXPECT_EQ(int{lost.state}, int{M::STATE_LOST});
   EXPECT_EQ(lost.detail, "serial port hung up");
+  // The calibration in force goes out with every status, whatever the link does.
+  EXPECT_EQ(lost.calibration, "");
+  const M calibrated = published(s, 40'000, {}, "2026-11-26T06:09:37Z vitreo-calibrate 0.1.0");
+  EXPECT_EQ(calibrated.calibration, "2026-11-26T06:09:37Z vitreo-calibrate 0.1.0");
 }
 
 // event_t from a real core step: a membrane bound by weak attachments, lifted by forceps (the peel
