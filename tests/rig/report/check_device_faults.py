@@ -40,6 +40,7 @@ for dev_id, s in last.items():
     who = s.name
     check(f"{who}: name", d["name"] == s.name, d["name"])
     check(f"{who}: transport", d["transport"] == s.transport, d["transport"])
+    check(f"{who}: calibration in force", d["calibration"] == s.calibration, d["calibration"])
     check(f"{who}: state at the end", d["state"] == STATES[s.state], f'{d["state"]} vs {s.state}')
     check(f"{who}: status messages", d["status_messages"] == sum(1 for x in statuses if x.device_id == dev_id), d["status_messages"])
     for field in ("frames_rx", "sequence_gaps", "heartbeat_misses", "reconnects", "stuck_episodes", "stuck_samples", "timestamp_jumps",
