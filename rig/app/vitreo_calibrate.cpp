@@ -24,6 +24,7 @@
 
 #include "rig/calibration/calibration_file.hpp"
 #include "rig/calibration/procedure.hpp"
+#include "rig/report/calibration_report.hpp"
 #include "rig/session/device_hub.hpp"
 #include "rig/session/device_inputs.hpp"
 #include "rig/session/rig_file.hpp"
@@ -189,21 +190,34 @@ int main(int argc, char** argv) {
     std::printf("  %s %-10s %s: %s\n", o.ok ? "ok  " : "FAIL", o.step->device.c_str(), o.step->instruction.c_str(), o.feedback.c_str());
   for (const std::string& e : link_events) a.errors.push_back(e), a.ok = false;
   std::printf("\n%s", cal::summary_text(a).c_str());
-  if (!a.ok) {
-    std::fprintf(stderr, "vitreo-calibrate: calibration failed; %s was not written (a previous calibration there is kept)\n",
-                 out_path.c_str());
-    return 1;
-  }
   a.file.created_unix_s =
       std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   a.file.tool = std::string("vitreo-calibrate ") + VITREO_VERSION;
   a.file.rig = rig.name;
-  try {
-    cal::write_calibration_file(out_path, a.file);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
-    return 1;
+  bool written = false;
+  if (a.ok) {
+    try {
+      cal::write_calibration_file(out_path, a.file);
+      written = true;
+      std::printf("wrote %s\n", out_path.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    }
+  } else {
+    std::fprintf(stderr, "vitreo-calibrate: calibration failed; %s was not written (a previous calibration there is kept)\n",
+                 out_path.c_str());
   }
-  std::printf("wrote %s\n", out_path.c_str());
-  return 0;
+  // The report a technician files, passed or failed: beside the calibration file.
+  const std::string base = out_path.size() > 5 && out_path.ends_with(".toml") ? out_path.substr(0, out_path.size() - 5) : out_path;
+  try {
+    vitreo::report::CalibrationReportInputs in;
+    in.analysis = &a;
+    if (written) in.calibration_file = out_path;
+    in.generated = cal::utc_timestamp(a.file.created_unix_s);
+    const auto r = vitreo::report::write_calibration_report(base, in);
+    std::printf("report %s (numbers: %s)\n", r.html_path.c_str(), r.json_path.c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: the report was not written: %s\n", e.what());
+  }
+  return written ? 0 : 1;
 }

@@ -127,10 +127,34 @@ std::string vec_text(const core::Vec3& v) {
   return b;
 }
 
+PivotPlot pivot_plot(const ProcedureStep& s, const std::vector<PivotPose>& poses, const PivotResult& r) {
+  PivotPlot p;
+  p.device = s.device;
+  p.instrument = s.index;
+  p.ok = r.ok;
+  p.residuals_mm = r.residuals_mm;
+  p.rms_mm = r.rms_mm;
+  p.spread_deg = r.spread_deg;
+  if (poses.empty()) return p;
+  // The shafts' mean direction and two directions across it: each pose's tilt off the mean.
+  core::Vec3 mean = core::Vec3::Zero();
+  for (const PivotPose& q : poses) mean += q.orientation.normalized() * core::Vec3::UnitZ();
+  if (mean.norm() < 1e-9) return p;
+  mean.normalize();
+  const core::Vec3 u = mean.unitOrthogonal(), v = mean.cross(u);
+  for (const PivotPose& q : poses) {
+    const core::Vec3 axis = q.orientation.normalized() * core::Vec3::UnitZ();
+    p.tilt_x_deg.push_back(std::atan2(axis.dot(u), axis.dot(mean)) * 180.0 / std::numbers::pi);
+    p.tilt_y_deg.push_back(std::atan2(axis.dot(v), axis.dot(mean)) * 180.0 / std::numbers::pi);
+  }
+  return p;
+}
+
 }  // namespace
 
 Analysis analyse(const Procedure& proc, const Fixture& fixture, const Recording& rec, const Limits& limits) {
   Analysis a;
+  a.limits = limits;
   std::map<std::string, core::Vec3> tip_offset;  // by device, once its pivot passed
   std::vector<core::Vec3> touched;               // fiducials, tracker frame
   std::vector<std::vector<core::Vec3>> port_tips_rig(fixture.ports_mm.size());
@@ -156,6 +180,7 @@ Analysis analyse(const Procedure& proc, const Fixture& fixture, const Recording&
         std::vector<PivotPose> poses;
         for (const TimedPose& p : in_window(poses_of(s.device), s.start_s, s.end_s)) poses.push_back({p.position_mm, p.orientation});
         const PivotResult r = calibrate_pivot(poses, limits.pivot);
+        a.pivots.push_back(pivot_plot(s, poses, r));
         std::string fb = std::to_string(r.poses) + " samples, spread " + (fixed(r.spread_deg, 1) + "°") + ", RMS " +
                          (fixed(r.rms_mm, 3) + " mm") + (" (limit " + fixed(limits.pivot.max_rms_mm, 3) + " mm)");
         if (r.ok) {

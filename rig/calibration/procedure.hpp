@@ -104,12 +104,26 @@ struct Limits {
   ClockLimits clock;
 };
 
+// What the calibration report plots of one pivot calibration (rig/report/calibration_report.hpp):
+// each pose's residual, and where its shaft pointed — degrees off the mean axis, in two
+// perpendicular directions — which shows the spread the technician swung the handle through.
+struct PivotPlot {
+  std::string device;
+  int instrument = 0;
+  bool ok = false;
+  std::vector<double> residuals_mm;
+  std::vector<double> tilt_x_deg, tilt_y_deg;
+  double rms_mm = 0.0, spread_deg = 0.0;
+};
+
 struct Analysis {
   bool ok = false;          // every step passed: the calibration may be written
   std::vector<StepOutcome> steps;
   std::vector<std::string> errors;  // the failures, each naming its step
   CalibrationFile file;     // filled as far as the steps passed (created/tool/rig: the caller's)
   std::vector<double> fiducial_residuals_mm;
+  std::vector<PivotPlot> pivots;  // every pivot step, passed or not
+  Limits limits;                  // the tolerances it was judged by
 };
 
 Analysis analyse(const Procedure& procedure, const Fixture& fixture, const Recording& recording, const Limits& limits = {});
