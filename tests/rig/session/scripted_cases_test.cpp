@@ -25,6 +25,7 @@
 
 #include <unistd.h>
 
+#include "rig/report/write_report.hpp"
 #include "rig/scene_io/case_loader.hpp"
 #include "rig/session/rig_session.hpp"
 #include "rig/session/scripted_session.hpp"
@@ -52,6 +53,7 @@ fs::path script_path(const std::string& case_name, const std::string& kind) {
 struct Played {
   SessionSummary summary;
   SurgicalScript script;
+  fs::path dir;  // the session's folder: its telemetry log (and, once written, its report)
 };
 
 // The rig's resolution on this 2-core machine; 0 plays the case at its own ([anatomy] retina_vertices).
@@ -88,6 +90,7 @@ Played play(const std::string& case_name, const fs::path& script_file, const std
     config.command_echo = std::tmpfile();  // the terminal's acks (it needs somewhere to print them)
   }
   out.summary = run_session(config);
+  out.dir = dir;
   if (fds[0] >= 0) ::close(fds[0]);
   if (config.command_echo) std::fclose(config.command_echo);
   return out;
@@ -117,6 +120,23 @@ double category(const SessionSummary& s, const char* name) {
 }
 
 #ifndef VITREO_LOCKSTEP_ONLY
+// Issue 17's bar: every scripted run gets its debrief (vitreo-report's writer on the run's telemetry
+// log), whose score is the one the session ended with; with `against`, also compare.html, this run
+// side by side with that one.
+void check_report(const Played& run, const Played* against = nullptr) {
+  report::ReportOptions options;
+  options.generated = "test";
+  if (against) options.compare_dir = against->dir.string();
+  const report::WrittenReport r = report::write_report(run.dir.string(), options);
+  EXPECT_TRUE(fs::file_size(r.json_path) > 0 && fs::file_size(r.html_path) > 0) << run.dir;
+  EXPECT_TRUE(r.final_score) << run.dir << ": the report has the session's final score";
+  EXPECT_NEAR(r.total, run.summary.score.total, 1e-9) << run.dir << ": the report's total is the session's";
+  if (against) {
+    EXPECT_FALSE(r.compare_path.empty());
+    EXPECT_GT(fs::file_size(r.compare_path), fs::file_size(r.html_path)) << "compare.html holds both sessions";
+  }
+}
+
 class ScriptedCase : public ::testing::TestWithParam<std::string> {};
 
 // Issue 15's acceptance for one case at `vertices` retina vertices: expert completes, clumsy lower,
@@ -134,6 +154,7 @@ void check_case(const std::string& name, int vertices) {
   EXPECT_EQ(category(idle.summary, "target_achievement"), 0.0);
   EXPECT_EQ(idle.summary.totals.iatrogenic_events(), 0u);
   EXPECT_EQ(idle.summary.totals.retina_tears, 0u);
+  check_report(idle);
 
   // A case nobody has written a completing expert for yet is reported as skipped (its idle run is
   // still checked above): the list of open cases is in the test's output, never hidden in a pass.
@@ -143,6 +164,7 @@ void check_case(const std::string& name, int vertices) {
   EXPECT_TRUE(expert.summary.case_completed) << name << ": the expert script does not complete the case";
   EXPECT_EQ(expert.summary.totals.retina_tears, 0u);
   EXPECT_GT(expert.summary.score.total, idle.summary.score.total);
+  check_report(expert);
 
   if (!have_clumsy) GTEST_SKIP() << name << ": the expert completes; no clumsy script yet";
   const Played clumsy = play(name, script_path(name, "clumsy"), "clumsy", -1.0, "", vertices);
@@ -152,6 +174,13 @@ void check_case(const std::string& name, int vertices) {
     std::printf(", %s %+.1f", e.name, e.value - category(clumsy.summary, e.name));
   }
   std::printf("\n");
+  // The clumsy run's debrief beside the expert's (compare.html): where its points went.
+  check_report(clumsy, &expert);
+  const core::ScoreEntry* lost_most = nullptr;
+  for (const auto& e : expert.summary.score.categories) {
+    if (!lost_most || e.value - category(clumsy.summary, e.name) > lost_most->value - category(clumsy.summary, lost_most->name)) lost_most = &e;
+  }
+  if (lost_most) std::printf("  clumsy lost most in %s (see %s)\n", lost_most->name, (clumsy.dir / "compare.html").c_str());
   // A clumsy surgeon still completes the case unless its script says why it cannot ("does not
   // complete: …" in its summary): there the gap to the expert must be plain.
   if (clumsy.script.summary.find("does not complete") == std::string::npos) {
