@@ -1,199 +1,57 @@
 // vitreo-calibrate: the technicians' sensor calibration (issue 18; rig/calibration/README.md).
 //
 //   vitreo-calibrate --rig rig/config/sim-calibration.toml --out rig.calibration.toml --non-interactive
+//   vitreo-calibrate --from-recording rig.calibration.recording --out again.calibration.toml
 //
 // Runs the procedure of rig/calibration/procedure.hpp against the rig file's devices over their
 // transports — tip pivot per instrument, tracker-to-fixture registration, ports, pedal travel, the
-// devices' clocks — prints each step with its feedback and a summary, and writes the calibration
-// file atomically only when every step passed (a failed run keeps the previous file).
+// eyeball fixture's zero, the devices' clocks — prints each step with its feedback and a summary,
+// and writes the calibration file atomically only when every step passed (a failed run keeps the
+// previous file). Every run leaves its report (NAME.report.html/.json) and its recording
+// (NAME.recording, every sample and each step's window) beside the file, passed or failed.
 //
-// --non-interactive plays a scripted technician: the procedure's motions become the simulated
-// devices' emulator keyframes (their own script's imperfections, noise and faults kept), and the
-// run goes in lockstep on the simulation's clock, so it is reproducible and as fast as the machine.
+// Who does the procedure:
+// - --non-interactive: a scripted technician (the surgical-script format, kind = "calibration";
+//   rig/session/technician_script.hpp), against simulated devices, in lockstep;
+// - --from-recording FILE: nobody — the samples of an earlier run are analysed again.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <map>
-#include <mutex>
-#include <sstream>
 
 #include "rig/calibration/calibration_file.hpp"
+#include "rig/calibration/calibration_recording.hpp"
 #include "rig/calibration/procedure.hpp"
 #include "rig/report/calibration_report.hpp"
-#include "rig/session/device_hub.hpp"
-#include "rig/session/device_inputs.hpp"
+#include "rig/session/calibration_run.hpp"
 #include "rig/session/rig_file.hpp"
-#include "rig/session/simulation_model.hpp"
+#include "rig/session/technician_script.hpp"
 
 namespace cal = vitreo::rig::calibration;
-using vitreo::rig::DeviceRole;
-using vitreo::rig::DeviceSpec;
+namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::uint64_t kStepUs = 1000;  // the lockstep grant: 1 ms, the trackers' sample period
-
-// The device's own script with its motion replaced by the technician's: every directive but `key`
-// and `loop` (imperfections, noise, serial, rate, faults) is kept.
-std::string technician_script(const DeviceSpec& d, const std::string& motion) {
-  std::istringstream in(d.sim_script);
-  std::string out, line;
-  bool have_device = false;
-  while (std::getline(in, line)) {
-    std::istringstream words(line);
-    std::string first;
-    words >> first;
-    if (first == "key" || first == "loop") continue;
-    if (first == "device") have_device = true;
-    out += line + "\n";
-  }
-  if (!have_device) out = "device " + std::string(vitreo::rig::to_string(d.role)) + "\n" + out;
-  if (d.role == DeviceRole::eyeball && motion.empty()) return out + "loop 0\nkey 0 0 0 0 0 0\n";
-  return out + "loop 0\n" + motion;
+// NAME.toml → NAME (the report's and the recording's base).
+std::string base_of(const std::string& out_path) {
+  return out_path.size() > 5 && out_path.ends_with(".toml") ? out_path.substr(0, out_path.size() - 5) : out_path;
 }
 
-bool is_sim(const DeviceSpec& d) { return d.uri.rfind("sim:", 0) == 0; }
-
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"vitreo-calibrate: calibrate the rig's sensors (tip pivot, registration, ports, pedals, clocks)\n"
-               "  vitreo-calibrate --rig rig/config/sim-calibration.toml --out rig.calibration.toml --non-interactive"};
-  std::string rig_path, out_path, motion_dir;
-  bool non_interactive = false;
-  app.add_option("--rig", rig_path, "the rig file whose devices are calibrated")->required()->check(CLI::ExistingFile);
-  app.add_option("--out", out_path, "the calibration file to write (atomically; kept as it was when a step fails)")->required();
-  app.add_flag("--non-interactive", non_interactive,
-               "a scripted technician performs the procedure against the rig's simulated devices (lockstep)");
-  app.add_option("--save-motion", motion_dir, "write the scripted technician's emulator scripts to this folder");
-  CLI11_PARSE(app, argc, argv);
-  spdlog::set_pattern("%^%l%$: %v");
-
-  vitreo::rig::RigFile rig;
-  try {
-    rig = vitreo::rig::read_rig_file(rig_path);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
-    return 2;
-  }
-  if (!non_interactive) {
-    std::fprintf(stderr,
-                 "vitreo-calibrate: the interactive procedure (a technician at real devices, confirming each step) is not "
-                 "implemented yet; run --non-interactive against simulated devices\n");
-    return 2;
-  }
-  for (const DeviceSpec& d : rig.devices) {
-    if (!is_sim(d)) {
-      std::fprintf(stderr, "vitreo-calibrate: %s (%s) is a real device; --non-interactive needs simulated devices (sim: URIs)\n",
-                   d.name.c_str(), d.uri.c_str());
-      return 2;
-    }
-  }
-
-  std::vector<cal::TrackerRole> trackers;
-  std::string pedals, eyeball;
-  for (const DeviceSpec& d : rig.devices) {
-    if (d.role == DeviceRole::tracker) trackers.push_back({d.name, d.channel});
-    if (d.role == DeviceRole::pedals && pedals.empty()) pedals = d.name;
-    if (d.role == DeviceRole::eyeball && eyeball.empty()) eyeball = d.name;
-  }
-  // Instrument 0 (the tool hand) registers and measures the ports when present.
-  std::stable_sort(trackers.begin(), trackers.end(), [](const auto& a, const auto& b) { return a.instrument < b.instrument; });
-  const cal::Fixture fixture = cal::default_fixture();
-  const cal::Procedure proc = cal::plan_procedure(fixture, trackers, pedals, eyeball);
-
-  std::vector<DeviceSpec> specs = rig.devices;
-  std::map<std::int32_t, std::string> name_of;
-  for (DeviceSpec& d : specs) {
-    const auto m = proc.motion.find(d.name);
-    d.sim_script = technician_script(d, m == proc.motion.end() ? std::string() : m->second);
-    name_of[d.device_id] = d.name;
-    if (!motion_dir.empty()) {
-      std::error_code ec;
-      std::filesystem::create_directories(motion_dir, ec);
-      std::ofstream f(std::filesystem::path(motion_dir) / (d.name + ".sim"));
-      if (!(f << d.sim_script) || !f.flush()) {
-        std::fprintf(stderr, "vitreo-calibrate: --save-motion: cannot write %s/%s.sim\n", motion_dir.c_str(), d.name.c_str());
-        return 2;
-      }
-    }
-  }
-
-  std::printf("vitreo-calibrate: %s, %zu devices, scripted technician (%.1f s of procedure)\n", rig.name.c_str(), specs.size(),
-              proc.duration_s);
-  cal::Recording rec;
-  std::mutex clocks_mutex;  // time syncs arrive on the hub's driver thread
-  std::vector<std::string> link_events;
-  try {
-    vitreo::rig::DeviceHub hub(specs, nullptr, vitreo::rig::HubMode::lockstep);
-    for (std::size_t i = 0; i < hub.device_count(); ++i) {
-      const std::string name = hub.name(i);
-      hub.on_time_sync(i, [&rec, &clocks_mutex, name](std::uint64_t t1, std::uint64_t t2, std::uint64_t t3, std::uint64_t t4) {
-        std::lock_guard lock(clocks_mutex);
-        rec.clocks[name].push_back({t1, t2, t3, t4});
-      });
-    }
-    hub.start();
-    hub.lockstep_connect();
-    // The file names the units it calibrated.
-    for (std::size_t i = 0; i < hub.device_count(); ++i)
-      if (proc.motion.count(hub.name(i))) rec.serials[hub.name(i)] = hub.announced_serial(i);
-    const std::uint64_t steps = static_cast<std::uint64_t>(proc.duration_s * 1e6 / kStepUs);
-    std::size_t next_step = 0;
-    std::vector<const cal::ProcedureStep*> ordered;
-    for (const cal::ProcedureStep& s : proc.steps)
-      if (s.kind != cal::StepKind::clock) ordered.push_back(&s);
-    std::stable_sort(ordered.begin(), ordered.end(), [](auto* a, auto* b) { return a->start_s < b->start_s; });
-    for (std::uint64_t k = 0; k < steps; ++k) {
-      const double t_s = static_cast<double>(k * kStepUs) * 1e-6;
-      while (next_step < ordered.size() && ordered[next_step]->start_s <= t_s) {
-        std::printf("[%5.1f s] %s: %s…\n", t_s, ordered[next_step]->device.c_str(), ordered[next_step]->instruction.c_str());
-        ++next_step;
-      }
-      hub.lockstep_deliver(k, kStepUs);
-      hub.take_new([&](const vitreo::telemetry::RecordedInput& in) {
-        namespace tm = vitreo::telemetry;
-        const std::string& name = name_of[in.device_id];
-        if (const auto* t = std::get_if<tm::TrackerSample>(&in.what)) {
-          const vitreo::rig::TrackedPose pose = vitreo::rig::tracked_pose(*t);
-          rec.poses[name].push_back({t_s, pose.tip_mm, pose.orientation});
-        } else if (const auto* e = std::get_if<tm::EyeFixtureSample>(&in.what)) {
-          rec.eyeball[name].push_back({t_s, vitreo::rig::fixture_orientation(*e)});
-        } else if (const auto* p = std::get_if<tm::PedalSample>(&in.what)) {
-          rec.pedals[name].push_back({t_s, p->pedal_id, {p->axes[0], p->axes[1]}});
-        } else if (const auto* l = std::get_if<tm::LinkChange>(&in.what); l && l->event != tm::LinkEvent::Up) {
-          char b[160];
-          std::snprintf(b, sizeof b, "%s: link %s at %.3f s", name.c_str(), l->event == tm::LinkEvent::Lost ? "lost" : "stuck", t_s);
-          link_events.emplace_back(b);
-          std::printf("[%5.1f s] %s\n", t_s, b);
-        }
-      });
-    }
-    hub.stop();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
-    return 1;
-  }
-
-  cal::Analysis a;
-  {
-    std::lock_guard lock(clocks_mutex);
-    a = cal::analyse(proc, fixture, rec);
-  }
+// The analysis of what was taken, the steps' feedback and summary printed, the file written when
+// every step passed, the report and the recording beside it. Returns the exit status.
+int finish(const cal::CalibrationSession& session, const std::string& out_path, const std::string& recording_path) {
+  cal::Analysis a = cal::analyse(session.procedure, cal::default_fixture(), session.recording);
   std::printf("\nsteps\n");
   for (const cal::StepOutcome& o : a.steps)
     std::printf("  %s %-10s %s: %s\n", o.ok ? "ok  " : "FAIL", o.step->device.c_str(), o.step->instruction.c_str(), o.feedback.c_str());
-  for (const std::string& e : link_events) a.errors.push_back(e), a.ok = false;
+  for (const std::string& e : session.events) a.errors.push_back(e), a.ok = false;
   std::printf("\n%s", cal::summary_text(a).c_str());
-  a.file.created_unix_s =
-      std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  a.file.created_unix_s = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   a.file.tool = std::string("vitreo-calibrate ") + VITREO_VERSION;
-  a.file.rig = rig.name;
+  a.file.rig = session.rig;
   bool written = false;
   if (a.ok) {
     try {
@@ -204,20 +62,125 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
     }
   } else {
-    std::fprintf(stderr, "vitreo-calibrate: calibration failed; %s was not written (a previous calibration there is kept)\n",
-                 out_path.c_str());
+    std::fprintf(stderr, "vitreo-calibrate: calibration failed; %s was not written (a previous calibration there is kept)\n", out_path.c_str());
   }
   // The report a technician files, passed or failed: beside the calibration file.
-  const std::string base = out_path.size() > 5 && out_path.ends_with(".toml") ? out_path.substr(0, out_path.size() - 5) : out_path;
   try {
     vitreo::report::CalibrationReportInputs in;
     in.analysis = &a;
     if (written) in.calibration_file = out_path;
     in.generated = cal::utc_timestamp(a.file.created_unix_s);
-    const auto r = vitreo::report::write_calibration_report(base, in);
+    const auto r = vitreo::report::write_calibration_report(base_of(out_path), in);
     std::printf("report %s (numbers: %s)\n", r.html_path.c_str(), r.json_path.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vitreo-calibrate: the report was not written: %s\n", e.what());
   }
+  if (!recording_path.empty()) {
+    try {
+      cal::write_calibration_recording(recording_path, session);
+      std::printf("recording %s\n", recording_path.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vitreo-calibrate: the recording was not written: %s\n", e.what());
+    }
+  }
   return written ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"vitreo-calibrate: calibrate the rig's sensors (tip pivot, registration, ports, pedals, eyeball zero, clocks)\n"
+               "  vitreo-calibrate --rig rig/config/sim-calibration.toml --out rig.calibration.toml --non-interactive\n"
+               "  vitreo-calibrate --from-recording rig.calibration.recording --out again.calibration.toml"};
+  std::string rig_path, out_path, motion_dir, technician_path, from_recording, record_path;
+  bool non_interactive = false;
+  app.add_option("--rig", rig_path, "the rig file whose devices are calibrated")->check(CLI::ExistingFile);
+  app.add_option("--out", out_path, "the calibration file to write (atomically; kept as it was when a step fails)")->required();
+  auto* scripted = app.add_flag("--non-interactive", non_interactive,
+                                "a scripted technician performs the procedure against the rig's simulated devices (lockstep)");
+  app.add_option("--technician-script", technician_path,
+                 "the scripted technician (kind = \"calibration\"; default: calibration-technician.toml beside the rig file)")
+      ->check(CLI::ExistingFile)
+      ->needs(scripted);
+  auto* replay = app.add_option("--from-recording", from_recording, "analyse the samples of an earlier run (its NAME.recording) again")
+                     ->check(CLI::ExistingFile)
+                     ->excludes(scripted);
+  app.add_option("--record", record_path, "where to write this run's recording (default: NAME.recording beside --out)");
+  app.add_option("--save-motion", motion_dir, "write the scripted technician's emulator scripts to this folder")->needs(scripted);
+  CLI11_PARSE(app, argc, argv);
+  (void)replay;
+  spdlog::set_pattern("%^%l%$: %v");
+  if (record_path.empty() && from_recording.empty()) record_path = base_of(out_path) + ".recording";
+
+  if (!from_recording.empty()) {
+    cal::CalibrationSession session;
+    try {
+      session = cal::read_calibration_recording(from_recording);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+      return 2;
+    }
+    std::printf("vitreo-calibrate: %s, the recorded run %s (%zu steps, %.1f s)\n", session.rig.c_str(), from_recording.c_str(),
+                session.procedure.steps.size(), session.procedure.duration_s);
+    return finish(session, out_path, record_path);
+  }
+
+  if (rig_path.empty()) {
+    std::fprintf(stderr, "vitreo-calibrate: --rig FILE: the rig whose devices are calibrated (or --from-recording FILE)\n");
+    return 2;
+  }
+  vitreo::rig::RigFile rig;
+  try {
+    rig = vitreo::rig::read_rig_file(rig_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    return 2;
+  }
+  if (!non_interactive) {
+    std::fprintf(stderr,
+                 "vitreo-calibrate: the interactive procedure (a technician at real devices, confirming each step) is not "
+                 "implemented yet; run --non-interactive against simulated devices, or --from-recording\n");
+    return 2;
+  }
+  const vitreo::rig::CalibrationRoles roles = vitreo::rig::calibration_roles(rig);
+  const cal::Fixture fixture = cal::default_fixture();
+  const std::vector<cal::ProcedureStep> planned = cal::plan_steps(fixture, roles.trackers, roles.pedals, roles.eyeball);
+
+  if (technician_path.empty()) technician_path = (fs::path(rig_path).parent_path() / "calibration-technician.toml").string();
+  cal::Procedure proc;
+  try {
+    const vitreo::rig::SurgicalScript script = vitreo::rig::read_surgical_script(technician_path);
+    proc = vitreo::rig::resolve_technician_script(script, fixture, {roles.trackers, roles.pedals, roles.eyeball}, planned);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    return 2;
+  }
+  if (const auto missing = cal::missing_steps(planned, proc.steps); !missing.empty()) {
+    std::fprintf(stderr, "vitreo-calibrate: %s does not do every step this rig needs:\n", technician_path.c_str());
+    for (const std::string& m : missing) std::fprintf(stderr, "  %s\n", m.c_str());
+    return 2;
+  }
+  if (!motion_dir.empty()) {
+    for (const vitreo::rig::DeviceSpec& d : rig.devices) {
+      const auto m = proc.motion.find(d.name);
+      std::error_code ec;
+      fs::create_directories(motion_dir, ec);
+      std::ofstream f(fs::path(motion_dir) / (d.name + ".sim"));
+      if (!(f << vitreo::rig::with_technician_motion(d, m == proc.motion.end() ? std::string() : m->second)) || !f.flush()) {
+        std::fprintf(stderr, "vitreo-calibrate: --save-motion: cannot write %s/%s.sim\n", motion_dir.c_str(), d.name.c_str());
+        return 2;
+      }
+    }
+  }
+
+  std::printf("vitreo-calibrate: %s, %zu devices, scripted technician %s (%.1f s of procedure)\n", rig.name.c_str(), rig.devices.size(),
+              technician_path.c_str(), proc.duration_s);
+  cal::CalibrationSession session;
+  try {
+    session = vitreo::rig::run_scripted_calibration(rig, proc, stdout);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    return 1;
+  }
+  return finish(session, out_path, record_path);
 }

@@ -24,9 +24,6 @@ Fixture default_fixture() {
 
 namespace {
 
-constexpr double kMove = 0.5, kHold = 0.7, kSettle = 0.15;  // s: a touch's move, hold, and the margin cut off each end
-const core::Vec3 kRest(30.0, 0.0, 25.0);                   // the instrument's parking place, well clear of the eye
-
 // fixed(v, n): v with n decimals (the feedback's numbers).
 std::string fixed(double v, int digits) {
   char b[64];
@@ -34,81 +31,57 @@ std::string fixed(double v, int digits) {
   return b;
 }
 
-// An emulator tracker key: time, tip (eye frame), yaw/pitch/roll in degrees, actuation 0.
-void tracker_key(std::string& out, double t_s, const core::Vec3& p, double yaw, double pitch, double roll) {
-  char b[160];
-  std::snprintf(b, sizeof b, "key %.1f %.4f %.4f %.4f %.3f %.3f %.3f 0\n", t_s * 1000.0, p.x(), p.y(), p.z(), yaw, pitch, roll);
-  out += b;
-}
+const char* const kStepKindNames[] = {"pivot", "fiducial", "port", "pedal_rest", "pedal_travel", "eye_zero", "clock"};
 
 }  // namespace
 
-Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
-                         const std::string& eyeball) {
-  Procedure proc;
-  double end = 0.0;
-  // Pivoting: a widening spiral of the shaft about the tip in the divot (two directions, so the
-  // offset along the shaft is observable), 6 s at 20 keys per second.
-  const double pivot_start = 0.5, pivot_end = 6.5;
-  for (const TrackerRole& t : trackers) {
-    std::string& m = proc.motion[t.device];
-    tracker_key(m, 0.0, kRest, 0, 0, 0);
-    tracker_key(m, pivot_start - 0.2, fixture.divot_mm, 0, 0, 0);
-    for (double s = pivot_start; s <= pivot_end + 1e-9; s += 0.05) {
-      const double u = (s - pivot_start) / (pivot_end - pivot_start);
-      const double amplitude = 10.0 + 18.0 * u, phase = 2.0 * std::numbers::pi * (s - pivot_start) / 1.5;
-      tracker_key(m, s, fixture.divot_mm, 15.0 * std::sin(0.7 * s), amplitude * std::sin(phase), amplitude * std::cos(phase));
-    }
-    proc.steps.push_back({StepKind::pivot, t.device, t.instrument, pivot_start + 0.1, pivot_end - 0.1,
-                          "rest the tip of instrument " + std::to_string(t.instrument) +
-                              " in the divot and swing the handle round it in widening circles"});
-  }
-  end = pivot_end;
-  if (!trackers.empty()) {
-    const TrackerRole& first = trackers.front();
-    std::string& m = proc.motion[first.device];
-    double t = pivot_end;
-    auto touch = [&](StepKind kind, int index, const core::Vec3& where, const std::string& what) {
-      tracker_key(m, t + kMove, where, 0.0, 25.0, 0.0);
-      tracker_key(m, t + kMove + kHold, where, 0.0, 25.0, 0.0);
-      proc.steps.push_back({kind, first.device, index, t + kMove + kSettle, t + kMove + kHold - kSettle, what});
-      t += kMove + kHold;
-    };
-    for (std::size_t i = 0; i < fixture.fiducials_mm.size(); ++i)
-      touch(StepKind::fiducial, static_cast<int>(i), fixture.fiducials_mm[i],
-            "touch fiducial " + std::to_string(i + 1) + " of " + std::to_string(fixture.fiducials_mm.size()) + " and hold still");
-    for (std::size_t i = 0; i < fixture.ports_mm.size(); ++i)
-      touch(StepKind::port, static_cast<int>(i), fixture.ports_mm[i],
-            "hold the tip in port " + std::to_string(i) + "'s trocar");
-    tracker_key(m, t + kMove, kRest, 0, 0, 0);
-    end = std::max(end, t + kMove);
-  }
+bool same_step(const ProcedureStep& a, const ProcedureStep& b) { return a.kind == b.kind && a.device == b.device && a.index == b.index; }
+
+std::string step_kind_name(StepKind k) { return kStepKindNames[static_cast<int>(k)]; }
+
+bool step_kind_from_name(const std::string& name, StepKind& k) {
+  for (int i = 0; i < 7; ++i)
+    if (name == kStepKindNames[i]) return k = static_cast<StepKind>(i), true;
+  return false;
+}
+
+std::vector<ProcedureStep> plan_steps(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
+                                      const std::string& eyeball) {
+  std::vector<ProcedureStep> steps;
+  auto step = [&](StepKind kind, const std::string& device, int index, const std::string& instruction) {
+    steps.push_back({kind, device, index, 0.0, 0.0, instruction});
+  };
+  if (!eyeball.empty()) step(StepKind::eye_zero, eyeball, 0, "leave the eye in its rest position");
   if (!pedals.empty()) {
-    // Rest, then each axis fully down, held, and up again.
-    std::string& m = proc.motion[pedals];
-    m += "key 0 0 0 0\nkey 1500 0 0 0\n";
-    proc.steps.push_back({StepKind::pedal_rest, pedals, 0, 0.3, 1.4, "leave both pedals alone"});
-    for (int axis = 0; axis < 2; ++axis) {
-      const double s = 1.5 + 2.5 * axis;
-      char b[200];
-      std::snprintf(b, sizeof b, "key %.0f %d %d 0\nkey %.0f %d %d 0\nkey %.0f 0 0 0\n", (s + 1.0) * 1000, axis == 0, axis == 1,
-                    (s + 1.5) * 1000, axis == 0, axis == 1, (s + 2.5) * 1000);
-      m += b;
-      proc.steps.push_back({StepKind::pedal_travel, pedals, axis, s, s + 2.5,
-                            std::string(axis == 0 ? "press the pedal" : "tilt the pedal sideways") + " all the way and let it back"});
-    }
-    end = std::max(end, 6.5);
+    step(StepKind::pedal_rest, pedals, 0, "leave both pedals alone");
+    step(StepKind::pedal_travel, pedals, 0, "press the pedal all the way and let it back");
+    step(StepKind::pedal_travel, pedals, 1, "tilt the pedal sideways all the way and let it back");
   }
-  if (!eyeball.empty()) {
-    // The eye is left in its rest position at the start: what the fixture reads then is its zero.
-    proc.motion[eyeball] = "key 0 0 0 0 0 0\n";
-    proc.steps.push_back({StepKind::eye_zero, eyeball, 0, 0.3, 1.4, "leave the eye in its rest position"});
+  for (const TrackerRole& t : trackers)
+    step(StepKind::pivot, t.device, t.instrument,
+         "rest the tip of instrument " + std::to_string(t.instrument) + " in the divot and swing the handle round it in widening circles");
+  if (!trackers.empty()) {
+    const std::string& first = trackers.front().device;
+    for (std::size_t i = 0; i < fixture.fiducials_mm.size(); ++i)
+      step(StepKind::fiducial, first, static_cast<int>(i),
+           "touch fiducial " + std::to_string(i + 1) + " of " + std::to_string(fixture.fiducials_mm.size()) + " and hold still");
+    for (std::size_t i = 0; i < fixture.ports_mm.size(); ++i)
+      step(StepKind::port, first, static_cast<int>(i), "hold the tip in port " + std::to_string(i) + "'s trocar");
   }
-  proc.duration_s = end + 0.5;
-  for (const TrackerRole& t : trackers) proc.steps.push_back({StepKind::clock, t.device, 0, 0.0, proc.duration_s, "keep the devices connected"});
+  for (const TrackerRole& t : trackers) step(StepKind::clock, t.device, 0, "keep the devices connected");
   for (const std::string& d : {pedals, eyeball})
-    if (!d.empty()) proc.steps.push_back({StepKind::clock, d, 0, 0.0, proc.duration_s, "keep the devices connected"});
-  return proc;
+    if (!d.empty()) step(StepKind::clock, d, 0, "keep the devices connected");
+  return steps;
+}
+
+std::vector<std::string> missing_steps(const std::vector<ProcedureStep>& planned, const std::vector<ProcedureStep>& done) {
+  std::vector<std::string> out;
+  for (const ProcedureStep& p : planned) {
+    bool found = false;
+    for (const ProcedureStep& d : done) found = found || same_step(p, d);
+    if (!found) out.push_back(p.device + ": " + p.instruction);
+  }
+  return out;
 }
 
 namespace {

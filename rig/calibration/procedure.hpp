@@ -1,14 +1,15 @@
 #pragma once
-// The calibration procedure: what the technician does, in which order and for how long, and how
-// the samples recorded meanwhile become a calibration.
+// The calibration procedure: what the technician does, in which order, and how the samples recorded
+// meanwhile become a calibration.
 //
-// plan_procedure() lays the steps on a timeline — pivot each instrument in the fixture's divot,
-// touch the fiducials with instrument 0, hold its tip in each port, leave the pedals at rest and
-// press each axis fully down — and writes the motions a scripted technician makes as keyframes in
-// the device emulators' script format (drivers/sim/emulator.hpp), so a run against simulated devices
-// is reproducible (vitreo-calibrate --save-motion writes them out). analyse() then cuts the recorded
-// samples by that timeline (each touch's middle, away from the moves) and runs the math of this
-// folder on them, step by step, with a line of feedback per step.
+// plan_steps() lists the steps a rig needs — pivot each instrument in the fixture's divot, touch
+// the fiducials with instrument 0, hold its tip in each port, leave the pedals and the eye at rest,
+// press each pedal axis fully down — each with the instruction the technician reads. Who does them
+// gives each step its window of time: a technician's script (rig/session/technician_script.hpp,
+// which also writes the simulated devices' motion), or the technician at the devices confirming each
+// step (vitreo-calibrate's guided mode), or a recorded calibration session
+// (calibration_recording.hpp). analyse() then cuts the recorded samples by those windows and runs
+// the math of this folder on them, step by step, with a line of feedback per step.
 #include <map>
 #include <string>
 #include <vector>
@@ -29,6 +30,7 @@ struct Fixture {
   std::vector<core::Vec3> fiducials_mm;               // machined touch points on the eye's shell and base
   std::vector<core::Vec3> ports_mm;                   // where the technician finds each port's trocar
   core::Vec3 tre_target_mm = core::Vec3(0.0, 0.0, -12.0);  // where TRE is predicted: the posterior pole
+  core::Vec3 rest_mm = core::Vec3(30.0, 0.0, 25.0);         // where an instrument is parked, well clear of the eye
 };
 // Eight fiducials (six on a ring about the cornea, the apex, one at the equator) and the two working
 // ports 3.5 mm behind the limbus at 10 and 2 o'clock of a 12 mm globe.
@@ -43,23 +45,33 @@ struct ProcedureStep {
   double start_s = 0.0, end_s = 0.0;  // when its samples count (the hold, without the moves)
   std::string instruction;  // what the technician is asked to do
 };
+// The same step (kind, device, index), whatever its window.
+bool same_step(const ProcedureStep& a, const ProcedureStep& b);
+// "pivot tracker-0 0", "fiducial tracker-0 3", … : how a recording names a step.
+std::string step_kind_name(StepKind k);
+bool step_kind_from_name(const std::string& name, StepKind& k);
 
 struct TrackerRole {
   std::string device;  // "tracker-0"
   int instrument = 0;
 };
 
+// The steps with their windows, as someone did them.
 struct Procedure {
   std::vector<ProcedureStep> steps;
   double duration_s = 0.0;
-  // Emulator keyframe lines ("key T ...") per device: the scripted technician.
+  // Emulator keyframe lines ("key T ...") per device: a scripted technician's motion (empty otherwise).
   std::map<std::string, std::string> motion;
 };
 
-// trackers: every tracker pivots; the first one (instrument 0 where present) also registers and
-// measures the ports. pedals, eyeball: the devices' names, empty for none.
-Procedure plan_procedure(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
-                         const std::string& eyeball = {});
+// The steps a rig's devices need, in the order a technician does them (windows 0): trackers: every
+// tracker pivots; the first one (instrument 0 where present) also touches the fiducials and measures
+// the ports. pedals, eyeball: the devices' names, empty for none. The devices' clocks are measured
+// throughout (a clock step per device, its window the whole run).
+std::vector<ProcedureStep> plan_steps(const Fixture& fixture, const std::vector<TrackerRole>& trackers, const std::string& pedals,
+                                      const std::string& eyeball = {});
+// The planned steps `done` lacks, as "DEVICE: instruction" lines (empty: nothing is missing).
+std::vector<std::string> missing_steps(const std::vector<ProcedureStep>& planned, const std::vector<ProcedureStep>& done);
 
 // What a run recorded, by device name, with session times in seconds.
 struct TimedPose {

@@ -112,14 +112,21 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
     if (*version != kSurgicalScriptVersion)
       r.fail(*r.get("version"), "version", "this is a version " + std::to_string(static_cast<long>(*version)) +
                                                " script; this vitreo reads version " + std::to_string(kSurgicalScriptVersion));
-    const auto name = r.string("case");
-    if (!name) r.fail_here("case", "missing: the case this script is written for");
-    s.case_name = *name;
     s.kind = r.string("kind").value_or("test");
-    if (s.kind != "expert" && s.kind != "clumsy" && s.kind != "idle" && s.kind != "test")
-      r.fail(*r.get("kind"), "kind", "must be expert, clumsy, idle or test");
+    if (s.kind != "expert" && s.kind != "clumsy" && s.kind != "idle" && s.kind != "test" && s.kind != "calibration")
+      r.fail(*r.get("kind"), "kind", "must be expert, clumsy, idle, test or calibration");
+    const auto name = r.string("case");
+    if (s.kind == "calibration") {
+      if (name) r.fail(*r.get("case"), "case", "a calibration script has no case: its landmarks are the fixture's");
+    } else {
+      if (!name) r.fail_here("case", "missing: the case this script is written for");
+      s.case_name = *name;
+    }
     s.summary = r.string("summary").value_or("");
     s.duration_s = r.number("duration_s", 0.01, 3600).value_or(s.duration_s);
+    if (s.kind == "calibration" && r.get("duration_s"))
+      r.fail(*r.get("duration_s"), "duration_s", "a calibration run lasts as long as the technician's motions");
+    if (s.kind == "calibration" && r.get("press_mm")) r.fail(*r.get("press_mm"), "press_mm", "not in a calibration script (no tissue)");
     s.seed = static_cast<std::uint64_t>(r.number("seed", 0, 1e15).value_or(1));
     s.tremor_mm = r.number("tremor_mm", 0, 2).value_or(0);
     s.speed_scale = r.number("speed_scale", 0.05, 20).value_or(1);
@@ -172,7 +179,34 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.reflux = w.boolean("reflux");
         p.air = w.boolean("air");
         p.pick = w.boolean("pick");
-        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick");
+        p.tilt_deg = w.number("tilt_deg", -80, 80);
+        if (const toml::node* n = w.get("swing_deg")) {
+          const toml::array* pair = n->as_array();
+          double v[2] = {0, 0};
+          if (!pair || pair->size() != 2) w.fail(*n, "swing_deg", "must be [from, to]: the shaft's tilt about the resting tip, in degrees");
+          for (std::size_t k = 0; k < 2; ++k) {
+            const toml::node& e = *pair->get(k);
+            if (e.is_integer()) v[k] = static_cast<double>(e.as_integer()->get());
+            else if (e.is_floating_point()) v[k] = e.as_floating_point()->get();
+            else w.fail(*n, "swing_deg", "must be [from, to] in degrees");
+            if (!std::isfinite(v[k]) || v[k] < 0 || v[k] > 60) w.fail(*n, "swing_deg", "each angle must be within [0, 60] degrees");
+          }
+          p.swing_deg = std::make_pair(v[0], v[1]);
+        }
+        p.swing_period_s = w.number("swing_period_s", 0.2, 20).value_or(p.swing_period_s);
+        p.records = w.string("records");
+        if (p.records) p.records_line = line_of(*w.get("records"));
+        p.travel = w.number("travel", 0, 1).value_or(p.travel);
+        // Each kind of script takes the keys that mean something for it: a technician's hand is free
+        // of ports and tools; a surgeon's is held by its port.
+        const bool calibration = s.kind == "calibration";
+        for (const char* k : {"tilt_deg", "swing_deg", "swing_period_s", "records", "travel"})
+          if (!calibration && w.get(k)) w.fail(*w.get(k), k, "only in calibration scripts (kind = \"calibration\")");
+        for (const char* k : {"above_mm", "toward_port_mm", "across_mm", "standoff_mm", "jaws", "roll_deg", "tool", "vacuum", "cut_rate",
+                              "laser", "reflux", "air", "pick"})
+          if (calibration && w.get(k))
+            w.fail(*w.get(k), k, "not in a calibration script (no case, no port, no tool; the pedals are pressed by `records = \"pedal_travel.AXIS\"`)");
+        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick, tilt_deg, swing_deg, swing_period_s, records, travel");
         h.waypoints.push_back(std::move(p));
       }
       r.refuse_unknown("tracker, speed_mm_s, waypoint");
@@ -381,6 +415,8 @@ struct PedalState {
 
 ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals) {
   const core::Scene& scene = *c.scene;
+  if (script.kind == "calibration")
+    throw std::runtime_error(script.file + ": script.kind: a calibration script is a technician's, played by vitreo-calibrate --technician-script");
   if (!scene.description.name.empty() && script.case_name != scene.description.name)
     throw std::runtime_error(script.file + ": script.case: written for '" + script.case_name + "', not for '" + scene.description.name + "'");
   LandmarkResolver landmarks(c, script);

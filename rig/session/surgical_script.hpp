@@ -50,6 +50,17 @@ struct ScriptWaypoint {
   std::optional<double> cut_rate;  // 0..1 of the side travel
   std::optional<bool> laser, reflux, air;
   std::optional<bool> pick;  // the light pipe's pick out (its own pedal switch)
+  // Calibration scripts only (kind = "calibration": a technician's hand, free of any port;
+  // rig/calibration/README.md): the shaft's tilt from the fixture's vertical on arrival, a swing of
+  // the handle about the resting tip during the hold (tilt growing from the first to the second
+  // angle, one circle every swing_period_s), which procedure step the hold's samples make
+  // (`records`), and how far a pedal is pressed during a pedal_travel hold.
+  std::optional<double> tilt_deg;
+  std::optional<std::pair<double, double>> swing_deg;
+  double swing_period_s = 1.5;
+  std::optional<std::string> records;
+  int records_line = 0;
+  double travel = 1.0;
 };
 
 struct ScriptHand {
@@ -70,7 +81,7 @@ struct ScriptFault {
 struct SurgicalScript {
   std::string file;        // where it was read from
   std::string case_name;   // the case it is written for
-  std::string kind;        // expert, clumsy, idle, test
+  std::string kind;        // expert, clumsy, idle, test; calibration (a technician's, no case)
   std::string summary;     // what it does (and, for a clumsy one, what it does wrong)
   double duration_s = 10.0;
   std::uint64_t seed = 1;  // sensor noise and tremor

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # A technician's day, end to end (label calibration): vitreo-calibrate the simulated rig with injected
-# imperfections, run vitreo with the calibration (its summary names it; the recording carries it and
+# imperfections (its scripted technician: rig/config/calibration-technician.toml), analyse the run's
+# recording again to the same calibration, see a trembling technician fail and a script that skips
+# steps refused, run vitreo with the calibration (its summary names it; the recording carries it and
 # replays to the same final state), and see the rig refuse the file for another tracker and a
 # malformed one with its file:line.
 set -u
@@ -14,6 +16,30 @@ rig="$SRC/rig/config/sim-calibration.toml"
 "$CAL" --rig "$rig" --out "$dir/cal.toml" --non-interactive --save-motion "$dir/motion" > "$dir/cal.out" 2>&1; rc=$?
 check "vitreo-calibrate passes and writes the file" '[ $rc -eq 0 ] && grep -q "result: PASS" "$dir/cal.out" && grep -q "^\[calibration\]" "$dir/cal.toml"'
 check "it saved the scripted technician's motion" 'grep -q "^tip_offset 0.8 -0.5 14.0" "$dir/motion/tracker-0.sim" && grep -c "^key " "$dir/motion/tracker-0.sim" | grep -qv "^1$"'
+check "it left the run's recording beside the file" 'grep -q "^recording $dir/cal.recording" "$dir/cal.out" && head -1 "$dir/cal.recording" | grep -qx "vitreo-calibration-recording 1"'
+
+"$CAL" --from-recording "$dir/cal.recording" --out "$dir/again.toml" > "$dir/again.out" 2>&1; rc=$?
+check "the recording analysed again gives the same calibration" '[ $rc -eq 0 ] && diff <(grep -v "^created\|^tool" "$dir/cal.toml") <(grep -v "^created\|^tool" "$dir/again.toml")'
+check "and the same summary" 'diff <(sed -n "/^calibration summary/,/result:/p" "$dir/cal.out") <(sed -n "/^calibration summary/,/result:/p" "$dir/again.out")'
+head -c 200000 "$dir/cal.recording" > "$dir/cut.recording"
+"$CAL" --from-recording "$dir/cut.recording" --out "$dir/cut.toml" > /dev/null 2> "$dir/cut.err"; rc=$?
+cut_line=$(wc -l < "$dir/cut.recording"); cut_line=$((cut_line + 1))
+check "a recording cut mid-line is refused at its line" '[ $rc -eq 2 ] && grep -q "cut.recording:$cut_line: .pose. takes 9 fields" "$dir/cut.err" && [ ! -e "$dir/cut.toml" ]'
+
+cp "$SRC/rig/config/calibration-technician.toml" "$dir/trembling.toml"
+sed -i "s/^seed = 1$/seed = 1\ntremor_mm = 0.3/" "$dir/trembling.toml"
+cp "$dir/cal.toml" "$dir/kept.toml"
+"$CAL" --rig "$rig" --out "$dir/kept.toml" --non-interactive --technician-script "$dir/trembling.toml" > "$dir/tremble.out" 2>&1; rc=$?
+check "a trembling technician fails the touches and the previous calibration is kept" '[ $rc -eq 1 ] && grep -q "FAIL tracker-0  touch fiducial 1 of 8 and hold still: the tip moved while touching" "$dir/tremble.out" && cmp -s "$dir/cal.toml" "$dir/kept.toml"'
+python3 - "$SRC/rig/config/calibration-technician.toml" "$dir/skips.toml" <<'PY'
+import sys
+text = open(sys.argv[1]).read()
+parts = text.split("[[hand.waypoint]]")
+open(sys.argv[2], "w").write("[[hand.waypoint]]".join(p for p in parts if 'records = "port"' not in p or 'port.1' not in p))
+PY
+"$CAL" --rig "$rig" --out "$dir/skips-cal.toml" --non-interactive --technician-script "$dir/skips.toml" > /dev/null 2> "$dir/skips.err"; rc=$?
+check "a technician script that skips a step is refused, naming it" '[ $rc -eq 2 ] && grep -q "does not do every step" "$dir/skips.err" && grep -q "tracker-0: hold the tip in port 1.s trocar" "$dir/skips.err"'
+
 "$CAL" --rig "$rig" --out "$dir/x.toml" > /dev/null 2> "$dir/err"; rc=$?
 check "without --non-interactive it says what is missing" '[ $rc -eq 2 ] && grep -q "not implemented yet" "$dir/err" && [ ! -e "$dir/x.toml" ]'
 

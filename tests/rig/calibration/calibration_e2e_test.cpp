@@ -115,8 +115,13 @@ TEST_F(CalibrationEndToEnd, RecoversEveryInjectedImperfectionWithinTheIssuesTole
   }
   EXPECT_LT(pedal_error, 0.02);
   // Clocks: both devices share the emulators' start and boot time, so their offsets differ by the
-  // injected offsets plus the injected drifts accumulated by the fit's reference time (the run's
-  // end, 20.5 ± 0.5 s in, so ±0.1 ms of uncertainty from the 210 ppm difference).
+  // injected offsets plus the injected drifts accumulated by the fit's reference time (near the
+  // run's end: the procedure's length less 0.5 ± 0.5 s, so ±0.1 ms of uncertainty from the 210 ppm
+  // difference). The tool prints the procedure's length: "(27.5 s of procedure)".
+  const std::size_t at = run_.output.find(" s of procedure)");
+  ASSERT_NE(at, std::string::npos) << run_.output;
+  const double procedure_s = std::stod(run_.output.substr(run_.output.rfind('(', at) + 1));
+  EXPECT_GT(procedure_s, 10.0);
   ASSERT_EQ(c.clocks.size(), 3u);  // tracker, pedals, eyeball
   auto clock_of = [&](const std::string& name) {
     for (const calibration::ClockRecord& r : c.clocks)
@@ -125,7 +130,7 @@ TEST_F(CalibrationEndToEnd, RecoversEveryInjectedImperfectionWithinTheIssuesTole
     return calibration::ClockRecord{};
   };
   const calibration::ClockRecord tracker = clock_of("tracker-0"), pedals = clock_of("pedals");
-  const double expected_difference_ms = (123.4 - -40.0) + (150.0 - -60.0) * 1e-6 * 20.5e3;
+  const double expected_difference_ms = (123.4 - -40.0) + (150.0 - -60.0) * 1e-6 * (procedure_s - 0.5) * 1e3;
   const double clock_error = std::abs((tracker.offset_ms - pedals.offset_ms) - expected_difference_ms);
   EXPECT_LT(clock_error, 0.5);
   EXPECT_NEAR(tracker.drift_ppm - pedals.drift_ppm, 210.0, 10.0);
@@ -243,10 +248,12 @@ TEST_F(CalibrationEndToEnd, IsRefusedForOtherSerialsAndItsRecordingCarriesIt) {
 
 TEST_F(CalibrationEndToEnd, ADeviceThatStopsMidwayFailsAndKeepsThePreviousCalibration) {
   ASSERT_EQ(run_.status, 0) << run_.output;
-  // The same rig, but the tracker's cable is pulled 9 s in (while touching the fiducials).
+  // The same rig (and its technician), but the tracker's cable is pulled 16 s in (while touching
+  // the fiducials: rig/config/calibration-technician.toml).
   const fs::path rig = dir_ / "stops.toml";
   fs::copy(kSource + "/rig/config/sim", dir_ / "sim", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
-  std::ofstream(dir_ / "sim/calibration-tracker.sim", std::ios::app) << "fault 9000 60000 disconnect\n";
+  fs::copy_file(kSource + "/rig/config/calibration-technician.toml", dir_ / "calibration-technician.toml", fs::copy_options::overwrite_existing);
+  std::ofstream(dir_ / "sim/calibration-tracker.sim", std::ios::app) << "fault 16000 60000 disconnect\n";
   std::ifstream r(kSource + "/rig/config/sim-calibration.toml");
   std::ofstream(rig) << r.rdbuf();
   const std::string previous = (dir_ / "previous.toml").string();
