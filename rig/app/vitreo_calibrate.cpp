@@ -11,6 +11,9 @@
 // (NAME.recording, every sample and each step's window) beside the file, passed or failed.
 //
 // Who does the procedure:
+// - by default a technician at the devices, guided step by step in the terminal with live feedback
+//   (rig/session/guided_calibration.hpp), in real time; with simulated devices, --technician-script
+//   makes their emulators play a scripted technician's motions meanwhile (a test engineer's rig);
 // - --non-interactive: a scripted technician (the surgical-script format, kind = "calibration";
 //   rig/session/technician_script.hpp), against simulated devices, in lockstep;
 // - --from-recording FILE: nobody — the samples of an earlier run are analysed again.
@@ -21,12 +24,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <unistd.h>
 
 #include "rig/calibration/calibration_file.hpp"
 #include "rig/calibration/calibration_recording.hpp"
 #include "rig/calibration/procedure.hpp"
 #include "rig/report/calibration_report.hpp"
 #include "rig/session/calibration_run.hpp"
+#include "rig/session/guided_calibration.hpp"
 #include "rig/session/rig_file.hpp"
 #include "rig/session/technician_script.hpp"
 
@@ -86,6 +91,23 @@ int finish(const cal::CalibrationSession& session, const std::string& out_path, 
   return written ? 0 : 1;
 }
 
+// The guided procedure at the rig's devices, answered on standard input.
+int guided(const vitreo::rig::RigFile& rig, const std::vector<cal::ProcedureStep>& planned, const std::string& out_path,
+           const std::string& recording_path) {
+  vitreo::rig::GuidedOutcome g;
+  try {
+    g = vitreo::rig::run_guided_calibration(rig, planned, STDIN_FILENO, stdout);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    return 1;
+  }
+  if (!g.completed) {
+    std::fprintf(stderr, "vitreo-calibrate: given up; %s was not written (a previous calibration there is kept)\n", out_path.c_str());
+    return 3;
+  }
+  return finish(g.session, out_path, recording_path);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -99,9 +121,9 @@ int main(int argc, char** argv) {
   auto* scripted = app.add_flag("--non-interactive", non_interactive,
                                 "a scripted technician performs the procedure against the rig's simulated devices (lockstep)");
   app.add_option("--technician-script", technician_path,
-                 "the scripted technician (kind = \"calibration\"; default: calibration-technician.toml beside the rig file)")
-      ->check(CLI::ExistingFile)
-      ->needs(scripted);
+                 "the scripted technician (kind = \"calibration\"; default with --non-interactive: calibration-technician.toml beside "
+                 "the rig file; guided: the simulated devices play it while the prompts are answered)")
+      ->check(CLI::ExistingFile);
   auto* replay = app.add_option("--from-recording", from_recording, "analyse the samples of an earlier run (its NAME.recording) again")
                      ->check(CLI::ExistingFile)
                      ->excludes(scripted);
@@ -136,18 +158,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
     return 2;
   }
-  if (!non_interactive) {
-    std::fprintf(stderr,
-                 "vitreo-calibrate: the interactive procedure (a technician at real devices, confirming each step) is not "
-                 "implemented yet; run --non-interactive against simulated devices, or --from-recording\n");
-    return 2;
-  }
   const vitreo::rig::CalibrationRoles roles = vitreo::rig::calibration_roles(rig);
   const cal::Fixture fixture = cal::default_fixture();
   const std::vector<cal::ProcedureStep> planned = cal::plan_steps(fixture, roles.trackers, roles.pedals, roles.eyeball);
 
-  if (technician_path.empty()) technician_path = (fs::path(rig_path).parent_path() / "calibration-technician.toml").string();
+  if (technician_path.empty() && non_interactive) technician_path = (fs::path(rig_path).parent_path() / "calibration-technician.toml").string();
   cal::Procedure proc;
+  if (!non_interactive && technician_path.empty()) return guided(rig, planned, out_path, record_path);
   try {
     const vitreo::rig::SurgicalScript script = vitreo::rig::read_surgical_script(technician_path);
     proc = vitreo::rig::resolve_technician_script(script, fixture, {roles.trackers, roles.pedals, roles.eyeball}, planned);
@@ -159,6 +176,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "vitreo-calibrate: %s does not do every step this rig needs:\n", technician_path.c_str());
     for (const std::string& m : missing) std::fprintf(stderr, "  %s\n", m.c_str());
     return 2;
+  }
+  if (!non_interactive) {
+    // Guided, with simulated devices playing the scripted technician's motion in real time.
+    for (vitreo::rig::DeviceSpec& d : rig.devices) {
+      if (d.uri.rfind("sim:", 0) != 0) {
+        std::fprintf(stderr, "vitreo-calibrate: --technician-script moves simulated devices; %s (%s) is a real one\n", d.name.c_str(), d.uri.c_str());
+        return 2;
+      }
+      const auto m = proc.motion.find(d.name);
+      d.sim_script = vitreo::rig::with_technician_motion(d, m == proc.motion.end() ? std::string() : m->second);
+    }
+    return guided(rig, planned, out_path, record_path);
   }
   if (!motion_dir.empty()) {
     for (const vitreo::rig::DeviceSpec& d : rig.devices) {

@@ -18,6 +18,25 @@ bool is_sim(const DeviceSpec& d) { return d.uri.rfind("sim:", 0) == 0; }
 
 }  // namespace
 
+void record_calibration_input(calibration::CalibrationSession& session, const std::string& name, double t_s, const telemetry::RecordedInput& in,
+                              std::FILE* progress) {
+  namespace tm = telemetry;
+  calibration::Recording& rec = session.recording;
+  if (const auto* t = std::get_if<tm::TrackerSample>(&in.what)) {
+    const TrackedPose pose = tracked_pose(*t);
+    rec.poses[name].push_back({t_s, pose.tip_mm, pose.orientation});
+  } else if (const auto* e = std::get_if<tm::EyeFixtureSample>(&in.what)) {
+    rec.eyeball[name].push_back({t_s, fixture_orientation(*e)});
+  } else if (const auto* p = std::get_if<tm::PedalSample>(&in.what)) {
+    rec.pedals[name].push_back({t_s, p->pedal_id, {p->axes[0], p->axes[1]}});
+  } else if (const auto* l = std::get_if<tm::LinkChange>(&in.what); l && l->event != tm::LinkEvent::Up) {
+    char b[160];
+    std::snprintf(b, sizeof b, "%s: link %s at %.3f s", name.c_str(), l->event == tm::LinkEvent::Lost ? "lost" : "stuck", t_s);
+    session.events.emplace_back(b);
+    std::fprintf(progress, "[%5.1f s] %s\n", t_s, b);
+  }
+}
+
 CalibrationRoles calibration_roles(const RigFile& rig) {
   CalibrationRoles r;
   for (const DeviceSpec& d : rig.devices) {
@@ -89,23 +108,7 @@ calibration::CalibrationSession run_scripted_calibration(const RigFile& rig, con
       ++next_step;
     }
     hub.lockstep_deliver(k, kStepUs);
-    hub.take_new([&](const telemetry::RecordedInput& in) {
-      namespace tm = telemetry;
-      const std::string& name = name_of[in.device_id];
-      if (const auto* t = std::get_if<tm::TrackerSample>(&in.what)) {
-        const TrackedPose pose = tracked_pose(*t);
-        rec.poses[name].push_back({t_s, pose.tip_mm, pose.orientation});
-      } else if (const auto* e = std::get_if<tm::EyeFixtureSample>(&in.what)) {
-        rec.eyeball[name].push_back({t_s, fixture_orientation(*e)});
-      } else if (const auto* p = std::get_if<tm::PedalSample>(&in.what)) {
-        rec.pedals[name].push_back({t_s, p->pedal_id, {p->axes[0], p->axes[1]}});
-      } else if (const auto* l = std::get_if<tm::LinkChange>(&in.what); l && l->event != tm::LinkEvent::Up) {
-        char b[160];
-        std::snprintf(b, sizeof b, "%s: link %s at %.3f s", name.c_str(), l->event == tm::LinkEvent::Lost ? "lost" : "stuck", t_s);
-        session.events.emplace_back(b);
-        std::fprintf(progress, "[%5.1f s] %s\n", t_s, b);
-      }
-    });
+    hub.take_new([&](const telemetry::RecordedInput& in) { record_calibration_input(session, name_of[in.device_id], t_s, in, progress); });
   }
   hub.stop();
   return session;

@@ -12,6 +12,7 @@
 
 #include "rig/calibration/calibration_recording.hpp"
 #include "rig/session/rig_file.hpp"
+#include "rig/telemetry/input_record.hpp"
 
 namespace vitreo::rig {
 
@@ -21,6 +22,11 @@ struct CalibrationRoles {
   std::string pedals, eyeball;
 };
 CalibrationRoles calibration_roles(const RigFile& rig);
+
+// One input from the hub into the calibration's recording at session time t_s (samples by device
+// name; a link lost or stuck is a fault of the run, printed and kept in session.events).
+void record_calibration_input(calibration::CalibrationSession& session, const std::string& device, double t_s,
+                              const telemetry::RecordedInput& in, std::FILE* progress);
 
 // The device's own emulator script with its motion ("key" and "loop" lines) replaced by `motion`.
 std::string with_technician_motion(const DeviceSpec& d, const std::string& motion);

@@ -40,8 +40,8 @@ PY
 "$CAL" --rig "$rig" --out "$dir/skips-cal.toml" --non-interactive --technician-script "$dir/skips.toml" > /dev/null 2> "$dir/skips.err"; rc=$?
 check "a technician script that skips a step is refused, naming it" '[ $rc -eq 2 ] && grep -q "does not do every step" "$dir/skips.err" && grep -q "tracker-0: hold the tip in port 1.s trocar" "$dir/skips.err"'
 
-"$CAL" --rig "$rig" --out "$dir/x.toml" > /dev/null 2> "$dir/err"; rc=$?
-check "without --non-interactive it says what is missing" '[ $rc -eq 2 ] && grep -q "not implemented yet" "$dir/err" && [ ! -e "$dir/x.toml" ]'
+"$CAL" --rig "$rig" --out "$dir/x.toml" < /dev/null > "$dir/guided.out" 2> "$dir/err"; rc=$?
+check "without --non-interactive it guides a technician; with no answers it gives up and writes nothing" '[ $rc -eq 3 ] && grep -q "^step 1 of 15 .*eyeball: leave the eye in its rest position" "$dir/guided.out" && grep -q "given up" "$dir/err" && [ ! -e "$dir/x.toml" ]'
 
 "$VITREO" --rig "$rig" --calibration "$dir/cal.toml" --duration 0.2 --no-render --out "$dir/run" > "$dir/run.out" 2>&1; rc=$?
 check "the rig runs with it and its summary names it" '[ $rc -eq 0 ] && grep -q "^  calibration      $dir/cal.toml (.*vitreo-calibrate" "$dir/run.out"'
