@@ -17,6 +17,11 @@
 // - --non-interactive: a scripted technician (the surgical-script format, kind = "calibration";
 //   rig/session/technician_script.hpp), against simulated devices, in lockstep;
 // - --from-recording FILE: nobody — the samples of an earlier run are analysed again.
+//
+// --eyepieces calibrates the stereo eyepiece displays instead (rig/session/eyepiece_calibration.hpp):
+// the technician adjusts each eye's image shift, the stereo base and convergence while looking at
+// the test pattern; only the file's [eyepieces] table changes. A sensor calibration written over a
+// file keeps its [eyepieces] table, so neither run undoes the other.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -31,6 +36,7 @@
 #include "rig/calibration/procedure.hpp"
 #include "rig/report/calibration_report.hpp"
 #include "rig/session/calibration_run.hpp"
+#include "rig/session/eyepiece_calibration.hpp"
 #include "rig/session/guided_calibration.hpp"
 #include "rig/session/rig_file.hpp"
 #include "rig/session/technician_script.hpp"
@@ -57,6 +63,14 @@ int finish(const cal::CalibrationSession& session, const std::string& out_path, 
   a.file.created_unix_s = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   a.file.tool = std::string("vitreo-calibrate ") + VITREO_VERSION;
   a.file.rig = session.rig;
+  // The eyepieces calibrated before (vitreo-calibrate --eyepieces) stay as they were.
+  if (fs::exists(out_path)) {
+    try {
+      a.file.eyepieces = cal::read_calibration_file(out_path).eyepieces;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vitreo-calibrate: the file there now is not kept whole (%s)\n", e.what());
+    }
+  }
   bool written = false;
   if (a.ok) {
     try {
@@ -89,6 +103,45 @@ int finish(const cal::CalibrationSession& session, const std::string& out_path, 
     }
   }
   return written ? 0 : 1;
+}
+
+// The eyepiece displays: the test pattern on the rig's outputs, adjusted on standard input; only the
+// file's [eyepieces] table changes (a file that cannot be read is not overwritten).
+int eyepieces(const std::string& out_path, const std::string& rig_name, vitreo::rig::EyepieceRunOptions options) {
+  cal::CalibrationFile file;
+  if (fs::exists(out_path)) {
+    try {
+      file = cal::read_calibration_file(out_path);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vitreo-calibrate: %s; it is not overwritten\n", e.what());
+      return 2;
+    }
+    if (file.eyepieces) options.start = *file.eyepieces;
+  } else {
+    file.rig = rig_name;
+  }
+  std::optional<cal::EyepieceRecord> kept;
+  try {
+    kept = vitreo::rig::run_eyepiece_calibration(options, STDIN_FILENO, stdout);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    return 1;
+  }
+  if (!kept) {
+    std::fprintf(stderr, "vitreo-calibrate: given up; %s was not changed\n", out_path.c_str());
+    return 3;
+  }
+  file.eyepieces = *kept;
+  file.created_unix_s = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  file.tool = std::string("vitreo-calibrate ") + VITREO_VERSION;
+  try {
+    cal::write_calibration_file(out_path, file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+    return 1;
+  }
+  std::printf("wrote %s ([eyepieces]; the rest of the file as it was)\n", out_path.c_str());
+  return 0;
 }
 
 // The guided procedure at the rig's devices, answered on standard input.
@@ -129,9 +182,45 @@ int main(int argc, char** argv) {
                      ->excludes(scripted);
   app.add_option("--record", record_path, "where to write this run's recording (default: NAME.recording beside --out)");
   app.add_option("--save-motion", motion_dir, "write the scripted technician's emulator scripts to this folder")->needs(scripted);
+  bool eyepiece_mode = false;
+  std::vector<std::string> displays;
+  vitreo::rig::EyepieceRunOptions eyepiece_options;
+  std::string pattern_dir;
+  auto* eyepiece_flag = app.add_flag("--eyepieces", eyepiece_mode,
+                                     "calibrate the stereo eyepiece displays at the test pattern (commands on standard input)")
+                            ->excludes(scripted)
+                            ->excludes(replay);
+  app.add_option("--display", displays, "with --eyepieces: show the pattern on a rig display, CARD[:CONNECTOR[:sbs|left|right]] (repeatable)")
+      ->needs(eyepiece_flag);
+  app.add_option("--frame-ring", eyepiece_options.frame_ring_name, "with --eyepieces: publish the pattern in this shared-memory ring")
+      ->needs(eyepiece_flag);
+  app.add_option("--pattern-png", pattern_dir, "with --eyepieces: write the pattern as last set to DIR/eyepieces_{left,right,stereo}.png")
+      ->needs(eyepiece_flag);
+  app.add_option("--eye-size", eyepiece_options.eye_width, "with --eyepieces: each eye's width in pixels (height 4/5 of it)")
+      ->check(CLI::Range(64, 4096))
+      ->needs(eyepiece_flag);
   CLI11_PARSE(app, argc, argv);
-  (void)replay;
   spdlog::set_pattern("%^%l%$: %v");
+  if (eyepiece_mode) {
+    std::string rig_name;
+    try {
+      for (const std::string& d : displays) eyepiece_options.displays.push_back(vitreo::render::parse_display_spec(d));
+      if (!rig_path.empty()) {
+        const vitreo::rig::RigFile rig = vitreo::rig::read_rig_file(rig_path);
+        rig_name = rig.name;
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vitreo-calibrate: %s\n", e.what());
+      return 2;
+    }
+    eyepiece_options.eye_height = eyepiece_options.eye_width * 4 / 5;
+    if (!pattern_dir.empty()) {
+      std::error_code ec;
+      fs::create_directories(pattern_dir, ec);
+      eyepiece_options.png_prefix = (fs::path(pattern_dir) / "eyepieces").string();
+    }
+    return eyepieces(out_path, rig_name, eyepiece_options);
+  }
   if (record_path.empty() && from_recording.empty()) record_path = base_of(out_path) + ".recording";
 
   if (!from_recording.empty()) {

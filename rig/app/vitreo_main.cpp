@@ -72,25 +72,6 @@ void sync_file(const std::string& lcm_url) {
   ::close(fd);
 }
 
-// --display CARD[:CONNECTOR[:sbs|left|right]]
-vitreo::render::KmsOptions parse_display(const std::string& spec) {
-  vitreo::render::KmsOptions o;
-  const auto a = spec.find(':');
-  o.card = spec.substr(0, a);
-  if (a != std::string::npos) {
-    const auto b = spec.find(':', a + 1);
-    o.connector = spec.substr(a + 1, b == std::string::npos ? std::string::npos : b - a - 1);
-    if (b != std::string::npos) {
-      const std::string layout = spec.substr(b + 1);
-      if (layout == "left") o.layout = vitreo::render::DisplayLayout::LeftEye;
-      else if (layout == "right") o.layout = vitreo::render::DisplayLayout::RightEye;
-      else if (layout != "sbs") throw std::runtime_error("--display " + spec + ": layout must be sbs, left or right");
-    }
-  }
-  if (o.card.empty()) throw std::runtime_error("--display " + spec + ": no card (e.g. /dev/dri/card0)");
-  return o;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -314,7 +295,7 @@ int main(int argc, char** argv) {
     config.frame_ring_name = frame_ring;
     config.instructor_ring_name = instructor_ring;
     if (render) fs::create_directories(config.png_dir);
-    for (const auto& d : displays) config.displays.push_back(parse_display(d));
+    for (const auto& d : displays) config.displays.push_back(vitreo::render::parse_display_spec(d));
     if (!config.displays.empty() && !render) throw std::runtime_error("--display needs rendering (drop --no-render)");
     using vitreo::rig::DeviceRole;
     if (!serial_devices.empty()) {
@@ -353,6 +334,7 @@ int main(int argc, char** argv) {
       calibration_in_force = calibration_path + " (" + vitreo::rig::calibration_id(load.file) + ")" +
                              (load.warnings.empty() ? "" : " — " + load.warnings.front());
       config.model = model;
+      if (load.file.eyepieces) config.eyepieces = vitreo::rig::eyepiece_settings(*load.file.eyepieces);
     }
     config.devices = devices;
     // Lockstep wherever every device is simulated (a scripted session's outcome must not depend on

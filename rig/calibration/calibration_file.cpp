@@ -204,6 +204,13 @@ std::string format_calibration(const CalibrationFile& c) {
     s += "zero_wxyz = [" + num(q.w(), 12) + ", " + num(q.x(), 12) + ", " + num(q.y(), 12) + ", " + num(q.z(), 12) + "]\n";
     s += "samples = " + std::to_string(c.eye_zero->samples) + "\nspread_deg = " + num(c.eye_zero->spread_deg, 4) + "\n";
   }
+  if (c.eyepieces) {
+    const EyepieceRecord& e = *c.eyepieces;
+    s += "\n[eyepieces]  # the stereo displays: each eye's image shift (pixels, x right, y up) and the stereo geometry\n";
+    s += "left_offset_px = [" + num(e.offset_px[0][0], 2) + ", " + num(e.offset_px[0][1], 2) + "]\n";
+    s += "right_offset_px = [" + num(e.offset_px[1][0], 2) + ", " + num(e.offset_px[1][1], 2) + "]\n";
+    s += "stereo_base_mm = " + num(e.stereo_base_mm, 3) + "\nconvergence_mm = " + num(e.convergence_mm, 3) + "  # 0: the working plane\n";
+  }
   for (const ClockRecord& k : c.clocks) {
     s += "\n[[clock]]\ndevice = " + quoted(k.device) + "\noffset_ms = " + num(k.offset_ms, 6) + "\n";
     s += "drift_ppm = " + num(k.drift_ppm, 3) + "\nlatency_ms = " + num(k.latency_ms, 6) + "\nrms_ms = " + num(k.rms_ms, 6) + "\n";
@@ -328,11 +335,20 @@ CalibrationFile parse_calibration(const std::string& text, const std::string& or
     t.no_others("device, offset_ms, drift_ppm, latency_ms, rms_ms");
     c.clocks.push_back(r);
   });
+  table("eyepieces", [&](TableReader& t) {
+    EyepieceRecord r;
+    const Eigen::VectorXd left = t.numbers("left_offset_px", 2, -2000.0, 2000.0), right = t.numbers("right_offset_px", 2, -2000.0, 2000.0);
+    for (int k = 0; k < 2; ++k) r.offset_px[0][k] = left(k), r.offset_px[1][k] = right(k);
+    r.stereo_base_mm = t.number("stereo_base_mm", 1.0, 100.0);
+    r.convergence_mm = t.number("convergence_mm", 0.0, 2000.0);
+    t.no_others("left_offset_px, right_offset_px, stereo_base_mm, convergence_mm");
+    c.eyepieces = r;
+  });
   for (const auto& [k, v] : root) {
     const std::string key(k.str());
     if (key != "calibration" && key != "device" && key != "registration" && key != "instrument" && key != "port" &&
-        key != "pedal" && key != "eyeball" && key != "clock")
-      fail_at(v, key, "unknown table (calibration, device, registration, instrument, port, pedal, eyeball, clock)");
+        key != "pedal" && key != "eyeball" && key != "clock" && key != "eyepieces")
+      fail_at(v, key, "unknown table (calibration, device, registration, instrument, port, pedal, eyeball, clock, eyepieces)");
   }
   return c;
 }

@@ -58,6 +58,14 @@ struct EyeZeroRecord {  // the eyeball fixture's reading with the eye at rest
   double spread_deg = 0.0;
 };
 
+// The stereo eyepiece displays, adjusted while looking at the test pattern (vitreo-calibrate
+// --eyepieces): each eye's image shift on its display, and the stereo geometry the renderer uses.
+struct EyepieceRecord {
+  double offset_px[2][2] = {{0.0, 0.0}, {0.0, 0.0}};  // [eye: left, right][x right, y up], display pixels
+  double stereo_base_mm = 22.0;                        // the two views' separation at the objective
+  double convergence_mm = 0.0;                         // zero-disparity distance; 0: at the working plane
+};
+
 struct ClockRecord {
   std::string device;
   double offset_ms = 0.0, drift_ppm = 0.0, latency_ms = 0.0, rms_ms = 0.0;
@@ -74,6 +82,7 @@ struct CalibrationFile {
   std::vector<PedalRecord> pedals;
   std::optional<EyeZeroRecord> eye_zero;
   std::vector<ClockRecord> clocks;
+  std::optional<EyepieceRecord> eyepieces;
 
   const InstrumentRecord* instrument(int channel) const;
   const PortRecord* port(int index) const;

@@ -70,9 +70,26 @@ CalibrationLoad load_calibration(const std::string& path, std::vector<DeviceSpec
                   load.file.registration->fre_mm, load.file.registration->tre_mm);
     load.notes.emplace_back(b);
   }
+  if (load.file.eyepieces) {
+    const calibration::EyepieceRecord& e = *load.file.eyepieces;
+    char b[240];
+    std::snprintf(b, sizeof b, "eyepiece displays: left image shifted (%.1f, %.1f) px, right (%.1f, %.1f) px; stereo base %.1f mm, convergence %s",
+                  e.offset_px[0][0], e.offset_px[0][1], e.offset_px[1][0], e.offset_px[1][1], e.stereo_base_mm,
+                  e.convergence_mm > 0 ? (std::to_string(static_cast<int>(std::lround(e.convergence_mm))) + " mm").c_str() : "at the working plane");
+    load.notes.emplace_back(b);
+  }
   devices = std::move(pinned);
   model = std::move(candidate);
   return load;
+}
+
+render::EyepieceSettings eyepiece_settings(const calibration::EyepieceRecord& e) {
+  render::EyepieceSettings out;
+  for (int eye = 0; eye < 2; ++eye)
+    out.offset_px[static_cast<std::size_t>(eye)] = {static_cast<float>(e.offset_px[eye][0]), static_cast<float>(e.offset_px[eye][1])};
+  out.stereo_base_mm = static_cast<float>(e.stereo_base_mm);
+  out.convergence_mm = static_cast<float>(e.convergence_mm);
+  return out;
 }
 
 }  // namespace vitreo::rig

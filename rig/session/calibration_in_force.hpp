@@ -3,13 +3,14 @@
 // written by vitreo-calibrate) applied to the input mapping — the tracker-to-eye registration and
 // each instrument's tip offset (TrackerCalibration), the ports measured on the fixture, the pedals'
 // ranges and dead zones (PedalMapping::axis_ranges), the eyeball fixture's rest reading
-// (ModelConfig::eye_zero). `vitreo --calibration FILE` or the rig file's [calibration] file.
+// (ModelConfig::eye_zero), and the stereo eyepiece displays' alignment for the renderer. `vitreo --calibration FILE` or the rig file's [calibration] file.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "rig/calibration/calibration_file.hpp"
 #include "rig/session/rig_file.hpp"
+#include "vitreo/render/frame_scene.hpp"
 #include "rig/session/simulation_model.hpp"
 
 namespace vitreo::rig {
@@ -32,6 +33,9 @@ struct CalibrationLoad {
 // Warns when the file is older than max_age_days at now_unix_s.
 CalibrationLoad load_calibration(const std::string& path, std::vector<DeviceSpec>& devices, ModelConfig& model,
                                  double max_age_days, std::int64_t now_unix_s);
+
+// The eyepiece displays' calibration as the renderer applies it (RenderThreadOptions::eyepieces).
+render::EyepieceSettings eyepiece_settings(const calibration::EyepieceRecord& e);
 
 // "2026-11-26T06:09:37Z vitreo-calibrate 0.1.0": which calibration is in force, for logs and telemetry.
 std::string calibration_id(const calibration::CalibrationFile& c);

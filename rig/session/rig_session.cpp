@@ -221,6 +221,7 @@ SessionSummary run_session(const SessionConfig& config) {
     ro.displays = config.displays;
     ro.shm_ring_name = config.frame_ring_name;
     ro.instructor_ring_name = config.instructor_ring_name;
+    ro.eyepieces = config.eyepieces;
     renderer = std::make_unique<render::RenderThread>(ro);
   }
   const std::uint64_t view_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(1.0 / (config.display_hz * config.model.dt_s)));

@@ -13,6 +13,7 @@
 #include "rig/session/device_hub.hpp"
 #include "rig/session/simulation_model.hpp"
 #include "rig/telemetry/recording.hpp"
+#include "vitreo/render/frame_scene.hpp"
 #include "vitreo/render/kms_display.hpp"
 
 namespace vitreo::rig {
@@ -61,6 +62,8 @@ struct SessionConfig {
   std::string frame_ring_name, instructor_ring_name;
   // The rig's displays (KMS scan-out, rig/render/kms_display.hpp); empty: headless.
   std::vector<vitreo::render::KmsOptions> displays;
+  // The eyepiece displays' calibration (calibration_in_force.hpp); empty: the scenes' own microscope.
+  std::optional<vitreo::render::EyepieceSettings> eyepieces;
   // Running scores on VITREO_SCORE every this many steps (and a final one at the end).
   std::uint64_t score_every_steps = 1000;
 };

@@ -60,7 +60,10 @@ StereoViews stereo_views(const Microscope& m, float globe_radius_mm, int width, 
     const float top = near_plane * half_tan;
     const float half_w = top * aspect;
     const float shift = flip * s * near_plane / convergence;  // shear so both frusta meet at `convergence`
-    v.projection = frustum(-half_w - shift, half_w - shift, -top, top, near_plane, far_plane);
+    // The display's alignment: the picture moved by whole frustum-window pixels on its display.
+    const float dx = m.display_offset_px[e].x * 2.0f * half_w / static_cast<float>(std::max(width, 1));
+    const float dy = m.display_offset_px[e].y * 2.0f * top / static_cast<float>(std::max(height, 1));
+    v.projection = frustum(-half_w - shift - dx, half_w - shift - dx, -top - dy, top - dy, near_plane, far_plane);
     v.view_projection = v.projection * v.view;
     v.near_mm = near_plane;
     v.far_mm = far_plane;

@@ -280,4 +280,22 @@ std::string KmsDisplay::description() const {
          std::to_string(height_) + "@" + std::to_string(static_cast<int>(refresh_hz_ + 0.5)) + (page_flip_ ? " (page flip)" : " (mode set per frame)");
 }
 
+KmsOptions parse_display_spec(const std::string& spec) {
+  KmsOptions o;
+  const auto a = spec.find(':');
+  o.card = spec.substr(0, a);
+  if (a != std::string::npos) {
+    const auto b = spec.find(':', a + 1);
+    o.connector = spec.substr(a + 1, b == std::string::npos ? std::string::npos : b - a - 1);
+    if (b != std::string::npos) {
+      const std::string layout = spec.substr(b + 1);
+      if (layout == "left") o.layout = DisplayLayout::LeftEye;
+      else if (layout == "right") o.layout = DisplayLayout::RightEye;
+      else if (layout != "sbs") throw std::runtime_error("--display " + spec + ": layout must be sbs, left or right");
+    }
+  }
+  if (o.card.empty()) throw std::runtime_error("--display " + spec + ": no card (e.g. /dev/dri/card0)");
+  return o;
+}
+
 }  // namespace vitreo::render

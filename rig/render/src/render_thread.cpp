@@ -28,6 +28,7 @@ RenderThread::RenderThread(RenderThreadOptions options) : options_(std::move(opt
 RenderThread::~RenderThread() { stop(); }
 
 void RenderThread::publish(FrameScene scene) {
+  if (options_.eyepieces) options_.eyepieces->apply(scene.microscope);
   mailbox_.write(std::move(scene));
   // Wakes the render thread if it sleeps on wake_; a notify is a syscall at most, never a wait.
   wake_.fetch_add(1, std::memory_order_release);
@@ -40,6 +41,7 @@ void RenderThread::request_png(std::string path_prefix) {
 }
 
 bool RenderThread::keep(FrameScene scene, std::string path_prefix) {
+  if (options_.eyepieces) options_.eyepieces->apply(scene.microscope);
   {
     std::lock_guard lock(mutex_);
     if (kept_scene_) return false;

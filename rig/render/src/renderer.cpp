@@ -980,18 +980,22 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
     glViewport(e * s.eye_width, 0, s.eye_width, s.eye_height);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
-    for (const DrawItem& d : opaque) draw_scene_item(d, static_cast<int>(d.mesh->material));
+    const auto seen = [e](const DrawItem& d) { return d.mesh == nullptr || ((d.mesh->eyes >> e) & 1u) != 0; };
+    for (const DrawItem& d : opaque)
+      if (seen(d)) draw_scene_item(d, static_cast<int>(d.mesh->material));
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glDepthMask(GL_FALSE);
-    for (const DrawItem& d : translucent) draw_scene_item(d, static_cast<int>(d.mesh->material));
+    for (const DrawItem& d : translucent)
+      if (seen(d)) draw_scene_item(d, static_cast<int>(d.mesh->material));
     if (gas_on && disc.index_count > 0) {
       DrawItem di{nullptr, &disc, {{0.80f, 0.84f, 0.90f}, 0.12f, 1.2f, 80.0f, false}, 0};
       draw_scene_item(di, kDiscMaterial);
     }
     // Light itself last, added to whatever it shines through (order does not matter for a sum).
     glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ZERO, GL_ONE);
-    for (const DrawItem& d : glows) draw_scene_item(d, static_cast<int>(MaterialKind::Glow));
+    for (const DrawItem& d : glows)
+      if (seen(d)) draw_scene_item(d, static_cast<int>(MaterialKind::Glow));
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
   }

@@ -4,7 +4,9 @@
 # recording again to the same calibration, see a trembling technician fail and a script that skips
 # steps refused, run vitreo with the calibration (its summary names it; the recording carries it and
 # replays to the same final state), and see the rig refuse the file for another tracker and a
-# malformed one with its file:line.
+# malformed one with its file:line. Then the eyepiece displays: the right eye's picture shifted at
+# the test pattern, kept in the file beside the sensor calibration (and kept by a later sensor run),
+# applied by the rig: its left-eye frames byte for byte as before, its right-eye frames not.
 set -u
 CAL=${1:?usage: calibrate_then_run_test.sh <vitreo-calibrate> <vitreo> <source dir>}
 VITREO=${2:?}; SRC=${3:?}
@@ -47,6 +49,21 @@ check "without --non-interactive it guides a technician; with no answers it give
 check "the rig runs with it and its summary names it" '[ $rc -eq 0 ] && grep -q "^  calibration      $dir/cal.toml (.*vitreo-calibrate" "$dir/run.out"'
 check "the rig pins the calibrated units" 'grep -q "tracker-0 must announce serial 1001" "$dir/run.out"'
 check "the recording carries it and replays to the same state" 'grep -q "identical final state" "$dir/run.out" && grep -aq "^calibration [0-9]" "$dir/run/session.lcmlog"'
+
+cp "$dir/cal.toml" "$dir/eye.toml"
+printf 'right 3 -2\nbogus\nshow\ndone\n' | "$CAL" --eyepieces --out "$dir/eye.toml" --pattern-png "$dir/pattern" --eye-size 320 > "$dir/eye.out" 2>&1; rc=$?
+check "the eyepiece calibration writes its table and keeps the rest of the file" '[ $rc -eq 0 ] && grep -qx "right_offset_px = \[3.00, -2.00\]" "$dir/eye.toml" && diff <(grep -v "^created\|^tool\|^#\|^$" "$dir/cal.toml") <(sed "/^\[eyepieces\]/,/^convergence_mm/d" "$dir/eye.toml" | grep -v "^created\|^tool\|^#\|^$") > /dev/null'
+check "it answered a malformed command and showed the pattern" 'grep -q "'"'"'bogus'"'"': left DX DY" "$dir/eye.out" && [ -s "$dir/pattern/eyepieces_stereo.png" ]'
+cp "$dir/eye.toml" "$dir/eye-before.toml"
+printf 'right 9 9\nq\n' | "$CAL" --eyepieces --out "$dir/eye.toml" > /dev/null 2>&1; rc=$?
+check "giving up at the pattern changes nothing" '[ $rc -eq 3 ] && cmp -s "$dir/eye.toml" "$dir/eye-before.toml"'
+"$CAL" --from-recording "$dir/cal.recording" --out "$dir/eye.toml" > /dev/null 2>&1; rc=$?
+check "a sensor calibration written over the file keeps its eyepieces" '[ $rc -eq 0 ] && grep -qx "right_offset_px = \[3.00, -2.00\]" "$dir/eye.toml"'
+"$VITREO" --rig "$rig" --calibration "$dir/cal.toml" --duration 0.2 --eye-size 320 --no-verify --out "$dir/plain" > /dev/null 2>&1
+"$VITREO" --rig "$rig" --calibration "$dir/eye.toml" --duration 0.2 --eye-size 320 --no-verify --out "$dir/shifted" > "$dir/shifted.out" 2>&1; rc=$?
+check "the rig says which eyepiece settings it applies" '[ $rc -eq 0 ] && grep -q "eyepiece displays: left image shifted (0.0, 0.0) px, right (3.0, -2.0) px" "$dir/shifted.out"'
+last_left=$(ls "$dir/plain/frames/"step_*_left.png | tail -1); last_right=${last_left%_left.png}_right.png
+check "its last frame: the left eye as without, the right eye moved" '[ -s "$last_left" ] && cmp -s "$last_left" "$dir/shifted/frames/$(basename "$last_left")" && ! cmp -s "$last_right" "$dir/shifted/frames/$(basename "$last_right")"'
 
 sed 's/^id = 1$/id = 1\nserial = 4242/' "$rig" > "$dir/other-rig.toml"
 cp -r "$SRC/rig/config/sim" "$dir/sim"

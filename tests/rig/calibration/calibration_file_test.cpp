@@ -71,6 +71,12 @@ rms_ms = 0.004
 zero_wxyz = [0.6, 0.8, 0.0, 0.0]
 samples = 1100
 spread_deg = 0.04
+
+[eyepieces]
+left_offset_px = [0, 0]
+right_offset_px = [3.5, -2]
+stereo_base_mm = 24
+convergence_mm = 0
 )";
 
 TEST(CalibrationFile, ReadsTheDocumentedFormat) {
@@ -112,6 +118,12 @@ TEST(CalibrationFile, WritesWhatItReads) {
   EXPECT_LT(back.registration->rig_to_eye.angularDistance(c.registration->rig_to_eye), 1e-9);
   EXPECT_LT((back.instrument(1)->tip_offset_mm - c.instrument(1)->tip_offset_mm).norm(), 1e-6);
   EXPECT_LT((back.port(0)->outward - c.port(0)->outward).norm(), 1e-8);
+  ASSERT_TRUE(c.eyepieces && back.eyepieces);
+  EXPECT_EQ(c.eyepieces->offset_px[1][0], 3.5);
+  EXPECT_EQ(c.eyepieces->offset_px[1][1], -2.0);
+  EXPECT_EQ(c.eyepieces->stereo_base_mm, 24.0);
+  EXPECT_EQ(back.eyepieces->offset_px[1][0], 3.5);
+  EXPECT_EQ(back.eyepieces->stereo_base_mm, 24.0);
   EXPECT_EQ(format_calibration(back), format_calibration(c));
 }
 
@@ -151,7 +163,11 @@ INSTANTIATE_TEST_SUITE_P(
                       Bad{"rig = \"bench 2\"", "rig = \"bench 2", "cal.toml:6:"},
                       Bad{"name = \"pedals\"", "name = \"tracker\"", "cal.toml:13: device[1].name: 'tracker' is listed twice"},
                       Bad{"[calibration]", "[calibrat]", "cal.toml:1: calibration: no [calibration] table"},
-                      Bad{"zero_wxyz = [0.6, 0.8, 0.0, 0.0]", "zero_wxyz = [0.6, 0.6, 0.0, 0.0]", "cal.toml:53: eyeball.zero_wxyz: must be a unit"}));
+                      Bad{"zero_wxyz = [0.6, 0.8, 0.0, 0.0]", "zero_wxyz = [0.6, 0.6, 0.0, 0.0]", "cal.toml:53: eyeball.zero_wxyz: must be a unit"},
+                      Bad{"right_offset_px = [3.5, -2]", "right_offset_px = [3.5, -2, 0]", "cal.toml:59: eyepieces.right_offset_px: must be an array of 2"},
+                      Bad{"stereo_base_mm = 24", "stereo_base_mm = 0", "cal.toml:60: eyepieces.stereo_base_mm"},
+                      Bad{"convergence_mm = 0", "convergence = 0", "cal.toml:57: eyepieces.convergence_mm: missing"},
+                      Bad{"convergence_mm = 0", "convergence_mm = 0\ncolour = 1", "cal.toml:62: eyepieces.colour: unknown key"}));
 
 TEST(CalibrationFile, RefusesOtherDevicesSerials) {
   const CalibrationFile c = parse_calibration(kExample, "x.toml");

@@ -99,6 +99,9 @@ struct Mesh {
   bool detached = false;             // retina only: the whole mesh is detached (overrides Vertex::detachment)
   std::optional<bool> casts_shadow;  // empty: the material's default (instruments, membranes, detached retina)
   std::vector<LaserBurn> burns;      // all burns so far (append-only within a case; shrinking = reset)
+  /// Which eyes see it: bit 0 the left, bit 1 the right (the eyepiece test pattern's nonius marks
+  /// are each seen by one eye only); everything in a surgery is seen by both.
+  std::uint8_t eyes = 3;
 };
 
 /// The light pipe (endoilluminator): a spotlight from its tip. Absent → the interior is dark but for
@@ -160,6 +163,23 @@ struct Microscope {
   /// A wide-angle system's image without its re-inverter: what reaches the eyepieces is rotated 180°
   /// and the two eyes' images are swapped (pseudoscopic depth), as on a real rig.
   bool image_inverted = false;
+  /// Each eye's picture shifted on its display (pixels, x right, y up): the eyepiece displays'
+  /// alignment (EyepieceSettings), so a misaligned display still shows fusable images.
+  std::array<Vec2, 2> display_offset_px{};
+};
+
+/// The rig's stereo eyepiece displays as calibrated (vitreo-calibrate --eyepieces): each eye's image
+/// shift, and the stereo base and convergence the renderer uses for them. Applied to every frame the
+/// render thread draws; the wide-angle view keeps its own convergence (at its target).
+struct EyepieceSettings {
+  std::array<Vec2, 2> offset_px{};
+  float stereo_base_mm = 22.0f;
+  float convergence_mm = 0.0f;  // zero-disparity distance; ≤ 0: at the working plane
+  void apply(Microscope& m) const {
+    m.display_offset_px = offset_px;
+    m.stereo_base_mm = stereo_base_mm;
+    if (!m.wide_angle) m.convergence_distance_mm = convergence_mm;
+  }
 };
 
 struct FrameScene {

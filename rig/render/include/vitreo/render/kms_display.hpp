@@ -39,6 +39,10 @@ struct KmsOptions {
   int flip_timeout_ms = 100;  // longest wait for the previous page flip
 };
 
+// A display as the tools name it: CARD[:CONNECTOR[:sbs|left|right]], e.g. /dev/dri/card0:HDMI-A-1:left.
+// Throws std::runtime_error naming the spec when the layout is unknown or the card missing.
+KmsOptions parse_display_spec(const std::string& spec);
+
 // An RGBA8 image, rows top to bottom.
 struct RgbaView {
   const std::uint8_t* pixels = nullptr;

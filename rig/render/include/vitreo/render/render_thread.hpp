@@ -42,6 +42,9 @@ struct RenderThreadOptions {
   /// failure, with the reason). A display that fails later (unplugged) is dropped with an error in
   /// the log and display_errors(); rendering and the other outputs go on.
   std::vector<KmsOptions> displays;
+  /// The rig's eyepiece displays as calibrated: applied to every scene published or kept (each eye's
+  /// image shift, the stereo base and convergence). Empty: the scenes' own microscope.
+  std::optional<EyepieceSettings> eyepieces;
   /// Called on the render thread after each frame (keep it short; it delays the next frame only).
   std::function<void(const StereoFrame&)> on_frame;
 };
