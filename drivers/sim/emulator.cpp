@@ -22,10 +22,11 @@ namespace {
 constexpr std::uint64_t kBootUs = 5'000'000;  // the device has been up 5 s when the link starts
 constexpr std::uint64_t kHeartbeatUs = 100'000;
 
-std::size_t key_width(DeviceKind k) {
-  switch (k) {
+// Values per key: a pedal's axes and its switch word.
+std::size_t key_width(const Script& s) {
+  switch (s.kind) {
     case DeviceKind::tracker: return 7;
-    case DeviceKind::pedals: return 3;
+    case DeviceKind::pedals: return static_cast<std::size_t>(s.pedal_axes) + 1;
     case DeviceKind::eyeball: return 5;
   }
   return 0;
@@ -129,6 +130,11 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
         if (frame) s.imperfect.frame_ypr_deg[i] = v[i], s.imperfect.frame_t_mm[i] = v[i + 3];
         else s.imperfect.tip_offset_mm[i] = v[i];
       }
+    } else if (word == "pedal_id" || word == "axes") {
+      const bool id = word == "pedal_id";
+      if (!exactly(2, word + " N") || !num(1, a) || a < (id ? 0 : 1) || a > (id ? 255 : 4)) return fail(id ? "pedal_id must be 0..255" : "axes must be 1..4");
+      if (!s.keys.empty()) return fail(word + " must come before the first key");
+      (id ? s.pedal_id : s.pedal_axes) = static_cast<std::uint8_t>(a);
     } else if (word == "pedal_range") {
       if (!exactly(4, "pedal_range AXIS LO HI") || !num(1, a) || (a != 0 && a != 1) || !num(2, b)) return fail("pedal_range AXIS(0|1) LO HI");
       double hi = 0;
@@ -146,7 +152,7 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
       if (!exactly(2, "clock_drift_ppm Y") || !num(1, a) || std::fabs(a) > 10000) return fail("clock_drift_ppm must be -10000..10000");
       s.imperfect.clock_drift_ppm = a;
     } else if (word == "key") {
-      const std::size_t width = key_width(s.kind);
+      const std::size_t width = key_width(s);
       if (w.size() != width + 2)
         return fail("key for " + std::string(to_string(s.kind)) + " needs a time and " + std::to_string(width) + " values, got " +
                     std::to_string(w.size() - 1) + " numbers");
@@ -188,7 +194,7 @@ bool parse_script(const std::string& text, Script& out, std::string* error) {
   }
   if (s.keys.empty()) return fail("a script needs at least one key");
   for (auto& k : s.keys)
-    if (k.second.size() != key_width(s.kind)) return fail("keys do not match the device kind");
+    if (k.second.size() != key_width(s)) return fail("keys do not match the device kind");
   out = std::move(s);
   return true;
 }
@@ -315,7 +321,7 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
     if (t >= keys[i].first && t < keys[i + 1].first) {
       double a = double(t - keys[i].first) / double(keys[i + 1].first - keys[i].first);
       for (std::size_t j = 0; j < v.size(); ++j) v[j] = keys[i].second[j] + a * (keys[i + 1].second[j] - keys[i].second[j]);
-      if (s_.kind == DeviceKind::pedals) v[2] = keys[i].second[2];
+      if (s_.kind == DeviceKind::pedals) v[s_.pedal_axes] = keys[i].second[s_.pedal_axes];
       break;
     }
   }
@@ -356,17 +362,18 @@ vp_message FirmwareEmulator::make_sample(std::uint64_t t_script_us, std::uint64_
       m.type = VP_MSG_PEDAL_STATE;
       auto& p = m.u.pedal;
       p.timestamp_us = device_us;
-      p.pedal_id = 0;
-      p.axis_count = 2;
+      p.pedal_id = s_.pedal_id;
+      p.axis_count = s_.pedal_axes;
       // The keys are the pedal's travel; its potentiometer maps that onto lo..hi (0..1 when ideal).
       const Imperfections& im = s_.imperfect;
-      for (int a = 0; a < 2; ++a) {
+      for (int a = 0; a < s_.pedal_axes; ++a) {
         const double travel = std::clamp(v[static_cast<std::size_t>(a)], 0.0, 1.0);
-        const double raw = im.pedal_lo[a] == 0 && im.pedal_hi[a] == 1 ? travel : im.pedal_lo[a] + (im.pedal_hi[a] - im.pedal_lo[a]) * travel;
+        const bool ideal = a >= 2 || (im.pedal_lo[a] == 0 && im.pedal_hi[a] == 1);
+        const double raw = ideal ? travel : im.pedal_lo[a] + (im.pedal_hi[a] - im.pedal_lo[a]) * travel;
         p.axes[a] = static_cast<std::uint16_t>(raw * 65535.0 + 0.5);
       }
       // A script may say anything up to ±1e6 (parse_script): the switch word is 16 bits.
-      p.switches = static_cast<std::uint16_t>(std::clamp(v[2], 0.0, 65535.0));
+      p.switches = static_cast<std::uint16_t>(std::clamp(v[s_.pedal_axes], 0.0, 65535.0));
       break;
     }
     case DeviceKind::eyeball: {

@@ -32,7 +32,9 @@ struct FaultEvent {
 //   tool N  instrument N              (tracker only) tool type (PROTOCOL.md: 0 a universal handpiece,
 //                                     9 blade, ...) and tracker channel
 //   key <t_ms> <values...>            tracker: x_mm y_mm z_mm yaw_deg pitch_deg roll_deg actuation(0..1)
-//                                     pedals:  axis0 axis1 switches           (axes 0..1)
+//                                     pedals:  axis0 axis1 switches           (axes 0..1; with `axes N`, N axes then switches)
+//   pedal_id N   axes N               (pedals only, before the first key) the pedal's id (0 the vitrectomy
+//                                     pedal, 1 the microscope's) and its axis count 1..4 (default 0 and 2)
 //                                     eyeball: yaw_deg pitch_deg depth0_mm depth1_mm depth2_mm (0 = no instrument)
 //   corrupt <probability per byte>    drop <probability per frame>           seed N
 //   noise <scale>                     sensor noise, 1 by default (0: none): a real tracker and fixture
@@ -67,6 +69,7 @@ struct Script {
   bool autostream = false;
   std::uint8_t tool = VP_TOOL_FORCEPS;
   std::uint8_t instrument = 0;
+  std::uint8_t pedal_id = 0, pedal_axes = 2;  // pedals only
   std::vector<std::pair<std::uint64_t, std::vector<double>>> keys;
   std::vector<FaultEvent> faults;
   double corrupt_byte_prob = 0;

@@ -174,8 +174,8 @@ int main(int argc, char** argv) {
   auto* scripted = app.add_flag("--non-interactive", non_interactive,
                                 "a scripted technician performs the procedure against the rig's simulated devices (lockstep)");
   app.add_option("--technician-script", technician_path,
-                 "the scripted technician (kind = \"calibration\"; default with --non-interactive: calibration-technician.toml beside "
-                 "the rig file; guided: the simulated devices play it while the prompts are answered)")
+                 "the scripted technician (kind = \"calibration\"; default with --non-interactive: RIG.technician.toml beside "
+                 "the rig file RIG.toml; guided: the simulated devices play it while the prompts are answered)")
       ->check(CLI::ExistingFile);
   auto* replay = app.add_option("--from-recording", from_recording, "analyse the samples of an earlier run (its NAME.recording) again")
                      ->check(CLI::ExistingFile)
@@ -251,7 +251,10 @@ int main(int argc, char** argv) {
   const cal::Fixture fixture = cal::default_fixture();
   const std::vector<cal::ProcedureStep> planned = cal::plan_steps(fixture, roles.trackers, roles.pedals, roles.eyeball);
 
-  if (technician_path.empty() && non_interactive) technician_path = (fs::path(rig_path).parent_path() / "calibration-technician.toml").string();
+  if (technician_path.empty() && non_interactive) {
+    const fs::path rig_file(rig_path);
+    technician_path = (rig_file.parent_path() / (rig_file.stem().string() + ".technician.toml")).string();
+  }
   cal::Procedure proc;
   if (!non_interactive && technician_path.empty()) return guided(rig, planned, out_path, record_path);
   try {

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A technician's day, end to end (label calibration): vitreo-calibrate the simulated rig with injected
-# imperfections (its scripted technician: rig/config/calibration-technician.toml), analyse the run's
+# imperfections (its scripted technician: rig/config/sim-calibration.technician.toml), analyse the run's
 # recording again to the same calibration, see a trembling technician fail and a script that skips
 # steps refused, run vitreo with the calibration (its summary names it; the recording carries it and
 # replays to the same final state), and see the rig refuse the file for another tracker and a
@@ -28,12 +28,12 @@ head -c 200000 "$dir/cal.recording" > "$dir/cut.recording"
 cut_line=$(wc -l < "$dir/cut.recording"); cut_line=$((cut_line + 1))
 check "a recording cut mid-line is refused at its line" '[ $rc -eq 2 ] && grep -q "cut.recording:$cut_line: .pose. takes 9 fields" "$dir/cut.err" && [ ! -e "$dir/cut.toml" ]'
 
-cp "$SRC/rig/config/calibration-technician.toml" "$dir/trembling.toml"
+cp "$SRC/rig/config/sim-calibration.technician.toml" "$dir/trembling.toml"
 sed -i "s/^seed = 1$/seed = 1\ntremor_mm = 0.3/" "$dir/trembling.toml"
 cp "$dir/cal.toml" "$dir/kept.toml"
 "$CAL" --rig "$rig" --out "$dir/kept.toml" --non-interactive --technician-script "$dir/trembling.toml" > "$dir/tremble.out" 2>&1; rc=$?
 check "a trembling technician fails the touches and the previous calibration is kept" '[ $rc -eq 1 ] && grep -q "FAIL tracker-0  touch fiducial 1 of 8 and hold still: the tip moved while touching" "$dir/tremble.out" && cmp -s "$dir/cal.toml" "$dir/kept.toml"'
-python3 - "$SRC/rig/config/calibration-technician.toml" "$dir/skips.toml" <<'PY'
+python3 - "$SRC/rig/config/sim-calibration.technician.toml" "$dir/skips.toml" <<'PY'
 import sys
 text = open(sys.argv[1]).read()
 parts = text.split("[[hand.waypoint]]")

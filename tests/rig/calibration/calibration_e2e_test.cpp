@@ -249,10 +249,10 @@ TEST_F(CalibrationEndToEnd, IsRefusedForOtherSerialsAndItsRecordingCarriesIt) {
 TEST_F(CalibrationEndToEnd, ADeviceThatStopsMidwayFailsAndKeepsThePreviousCalibration) {
   ASSERT_EQ(run_.status, 0) << run_.output;
   // The same rig (and its technician), but the tracker's cable is pulled 16 s in (while touching
-  // the fiducials: rig/config/calibration-technician.toml).
+  // the fiducials: rig/config/sim-calibration.technician.toml, beside the copy as stops.technician.toml).
   const fs::path rig = dir_ / "stops.toml";
   fs::copy(kSource + "/rig/config/sim", dir_ / "sim", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
-  fs::copy_file(kSource + "/rig/config/calibration-technician.toml", dir_ / "calibration-technician.toml", fs::copy_options::overwrite_existing);
+  fs::copy_file(kSource + "/rig/config/sim-calibration.technician.toml", dir_ / "stops.technician.toml", fs::copy_options::overwrite_existing);
   std::ofstream(dir_ / "sim/calibration-tracker.sim", std::ios::app) << "fault 16000 60000 disconnect\n";
   std::ifstream r(kSource + "/rig/config/sim-calibration.toml");
   std::ofstream(rig) << r.rdbuf();

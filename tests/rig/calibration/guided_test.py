@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The guided calibration (label calibration): vitreo-calibrate without --non-interactive, at the
 simulated calibration rig in real time, its emulators playing the scripted technician's motions
-(rig/config/calibration-technician.toml) while this test answers the prompts as a technician at
+(rig/config/sim-calibration.technician.toml) while this test answers the prompts as a technician at
 the bench would: Enter to start each step, the pivot's Enter only once the tip rests in the divot.
 
 The pivot is first ended too early on purpose (Enter twice while the tip is still on its way): the
@@ -24,7 +24,7 @@ import time
 
 calibrate, source = sys.argv[1], sys.argv[2]
 rig = os.path.join(source, "rig/config/sim-calibration.toml")
-technician = os.path.join(source, "rig/config/calibration-technician.toml")
+technician = os.path.join(source, "rig/config/sim-calibration.technician.toml")
 failures = []
 
 

@@ -113,7 +113,7 @@ shutil.copytree(os.path.join(source, "rig/config/sim"), os.path.join(rig_dir, "s
 with open(os.path.join(rig_dir, "sim/calibration-tracker.sim"), "a") as f:
     f.write("fault 16000 60000 disconnect\n")  # while the fiducials are touched
 shutil.copy(os.path.join(source, "rig/config/sim-calibration.toml"), rig_dir)
-shutil.copy(os.path.join(source, "rig/config/calibration-technician.toml"), rig_dir)
+shutil.copy(os.path.join(source, "rig/config/sim-calibration.technician.toml"), rig_dir)
 bad_out = os.path.join(work, "failed.toml")
 b = run(os.path.join(rig_dir, "sim-calibration.toml"), bad_out)
 check("the failed calibration exits 1", b.returncode == 1, b.returncode)

@@ -33,6 +33,9 @@ TEST(RigFile, EveryShippedRigFileReads) {
   int files = 0;
   for (const auto& e : std::filesystem::directory_iterator(kConfig)) {
     if (e.path().extension() != ".toml") continue;
+    // A rig's scripted technician (RIG.technician.toml) is a surgical script, not a rig file: the
+    // technician-script tests read it.
+    if (e.path().filename().string().ends_with(".technician.toml")) continue;
     ++files;
     SCOPED_TRACE(e.path().string());
     const rig::RigFile f = rig::read_rig_file(e.path().string());

@@ -60,7 +60,7 @@ drivers::sim::Script emulator_script(const std::string& device_line, const std::
 
 TEST(TechnicianScript, TheShippedOneDoesEveryStepWithTheTipWhereTheFixtureSaysMeanwhile) {
   const calibration::Fixture f = calibration::default_fixture();
-  const calibration::Procedure p = resolve_technician_script(read_surgical_script(kSource + "/rig/config/calibration-technician.toml"), f, kRig, planned());
+  const calibration::Procedure p = resolve_technician_script(read_surgical_script(kSource + "/rig/config/sim-calibration.technician.toml"), f, kRig, planned());
   EXPECT_TRUE(calibration::missing_steps(planned(), p.steps).empty());
   EXPECT_EQ(p.steps.size(), planned().size());
   const drivers::sim::Script tracker = emulator_script("device tracker\n", p.motion.at("tracker-0"));
