@@ -93,7 +93,8 @@ for k, (t0, a0, dx, dy) in enumerate(plan):
         t = t0 + lat * (-dy) + rad * dx; a = a0 + lat * dx + rad * dy
         if j == 0:
             body += wp(t, a, f'standoff_mm = {stand}\nroll_deg = {roll}\njaws = 0.0\nspeed_mm_s = 4.0\n')
-            body += wp(t, a, f'speed_mm_s = {speed}\n')
+            # The expert centres the microscope's field on each stalk as the jaws slide in to it.
+            body += wp(t, a, f'speed_mm_s = {speed}\n' + ('look_at = "target"\n' if kind == 'expert' else ''))
             T += 1.2 + stand / speed
         else:
             body += wp(t0 + DITHER[j-1][0] * (-dy) + DITHER[j-1][1] * dx, a0 + DITHER[j-1][0] * dx + DITHER[j-1][1] * dy, 'duration_s = 0.15\njaws = 0.0\n')

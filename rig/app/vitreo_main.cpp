@@ -376,7 +376,7 @@ int main(int argc, char** argv) {
     }
     // Simulated devices without a script of their own play the surgical script, resolved against the
     // first case as loaded (its landmarks at its resolution).
-    config.adapt_devices = vitreo::rig::play_script(script, model.pedals);
+    config.adapt_devices = vitreo::rig::play_script(script, model.pedals, model.microscope);
 
     static std::atomic<int> stop_signal{0};
     vitreo::app::install_stop_signals(stop_signal);

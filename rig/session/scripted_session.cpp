@@ -17,16 +17,20 @@ std::vector<DeviceSpec> simulated_devices(const SurgicalScript& script) {
     if (h.tracker == kLightPipeTracker)
       devices.push_back({"tracker-1", DeviceRole::tracker, "sim:tracker?transport=pty", 4, kLightPipeTracker, 0, 0, ""});
   }
+  // At PROTOCOL.md's 500 Hz: no script was tuned with it at another rate.
+  if (works_microscope(script)) devices.push_back({kMicroscopePedalDevice, DeviceRole::pedals, "sim:pedals?transport=pty", 5, 0, 0, 0, ""});
   return devices;
 }
 
-std::function<void(const PreparedCase&, std::vector<DeviceSpec>&)> play_script(SurgicalScript script, PedalMapping pedals) {
-  return [script = std::move(script), pedals](const PreparedCase& c, std::vector<DeviceSpec>& specs) {
-    const ResolvedScript resolved = resolve_script(script, c, pedals);
+std::function<void(const PreparedCase&, std::vector<DeviceSpec>&)> play_script(SurgicalScript script, PedalMapping pedals,
+                                                                                core::MicroscopeSettings microscope) {
+  return [script = std::move(script), pedals, microscope](const PreparedCase& c, std::vector<DeviceSpec>& specs) {
+    const ResolvedScript resolved = resolve_script(script, c, pedals, microscope);
     for (auto& d : specs) {
       if (d.uri.rfind("sim:", 0) != 0 || !d.sim_script.empty()) continue;
-      const std::string name = d.role == DeviceRole::tracker ? "tracker-" + std::to_string(d.channel)
-                               : d.role == DeviceRole::pedals ? "pedals"
+      const std::string name = d.name == kMicroscopePedalDevice  ? d.name
+                               : d.role == DeviceRole::tracker ? "tracker-" + std::to_string(d.channel)
+                               : d.role == DeviceRole::pedals  ? "pedals"
                                                                : "eyeball";
       if (const auto it = resolved.device_scripts.find(name); it != resolved.device_scripts.end()) d.sim_script = it->second;
     }

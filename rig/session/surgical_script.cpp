@@ -179,6 +179,10 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.reflux = w.boolean("reflux");
         p.air = w.boolean("air");
         p.pick = w.boolean("pick");
+        p.zoom = w.number("zoom", 0.1, 40);
+        p.focus_mm = w.number("focus_mm", -20, 20);
+        p.look_at = w.string("look_at");
+        if (p.look_at) p.look_at_line = line_of(*w.get("look_at"));
         p.tilt_deg = w.number("tilt_deg", -80, 80);
         if (const toml::node* n = w.get("swing_deg")) {
           const toml::array* pair = n->as_array();
@@ -203,10 +207,10 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         for (const char* k : {"tilt_deg", "swing_deg", "swing_period_s", "records", "travel"})
           if (!calibration && w.get(k)) w.fail(*w.get(k), k, "only in calibration scripts (kind = \"calibration\")");
         for (const char* k : {"above_mm", "toward_port_mm", "across_mm", "standoff_mm", "jaws", "roll_deg", "tool", "vacuum", "cut_rate",
-                              "laser", "reflux", "air", "pick"})
+                              "laser", "reflux", "air", "pick", "zoom", "focus_mm", "look_at"})
           if (calibration && w.get(k))
             w.fail(*w.get(k), k, "not in a calibration script (no case, no port, no tool; the pedals are pressed by `records = \"pedal_travel.AXIS\"`)");
-        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick, tilt_deg, swing_deg, swing_period_s, records, travel");
+        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick, zoom, focus_mm, look_at, tilt_deg, swing_deg, swing_period_s, records, travel");
         h.waypoints.push_back(std::move(p));
       }
       r.refuse_unknown("tracker, speed_mm_s, waypoint");
@@ -405,6 +409,92 @@ std::string tracker_key(double t_ms, const Vec3& p, double jaws, const Vec3& eul
   return buf;
 }
 
+// A change of the microscope pedal a waypoint asks for, from its start on.
+struct MicroscopeChange {
+  double t_s;
+  std::optional<double> zoom, focus_mm;
+  std::optional<core::Vec2> look_at;  // fundus plane: where the field's centre goes
+  int line;
+  std::string key;
+};
+
+// The simulated microscope pedal's emulator script: zoom and focus axes set to what each change
+// asks, the joystick deflected toward each look_at target for as long as the pan takes at the
+// zoom then in force (core::Microscope: pan_speed_mm_s / zoom at full deflection), then let go; a
+// target beyond the microscope's reach takes the field as far as it goes (its centre stays within
+// pan_travel_mm of the posterior pole). Open loop like the rest
+// of the script: the zoom is taken as reached when the pan starts (the zoom motor needs about
+// 0.3 s per doubling), so a look_at right after a zoom change lands a little short or long.
+std::string microscope_pedal_script(std::vector<MicroscopeChange> changes, const PreparedCase& c, const PedalMapping& m,
+                                    const core::MicroscopeSettings& settings, const SurgicalScript& script) {
+  auto fail = [&](const MicroscopeChange& ch, const std::string& key, const std::string& why) -> void {
+    throw std::runtime_error(script.file + ":" + std::to_string(ch.line) + ": " + ch.key + "." + key + ": " + why);
+  };
+  std::stable_sort(changes.begin(), changes.end(), [](const MicroscopeChange& a, const MicroscopeChange& b) { return a.t_s < b.t_s; });
+  double axes[4] = {0.0, 0.5, 0.5, 0.5};  // by role: zoom travel, focus travel, joystick x, y (centred)
+  double zoom = m.zoom_min;
+  core::Vec2 centre = c.scene->eye.fundus_coords(c.focus_mm);  // the microscope starts on the region of interest
+  std::string keys;
+  double last_ms = -1.0;
+  auto key = [&](double t_ms) {
+    t_ms = std::max(t_ms, last_ms + 0.5);
+    double v[4] = {0.0, 0.0, 0.0, 0.0};
+    const int index[4] = {m.zoom_axis, m.focus_axis, m.pan_x_axis, m.pan_y_axis};
+    for (int r = 0; r < 4; ++r)
+      if (index[r] >= 0 && index[r] < 4) v[index[r]] = axes[r];
+    char b[128];
+    std::snprintf(b, sizeof b, "key %.1f %.6f %.6f %.6f %.6f 0\n", t_ms, v[0], v[1], v[2], v[3]);
+    keys += b;
+    last_ms = t_ms;
+  };
+  key(0.0);
+  double pan_ends_s = 0.0;
+  for (const MicroscopeChange& ch : changes) {
+    if (ch.t_s < pan_ends_s)
+      fail(ch, "look_at", "the field is still panning to the last look_at until " + std::to_string(pan_ends_s) + " s; change the microscope after that");
+    key(ch.t_s * 1e3);  // hold what was set until now
+    if (ch.zoom) {
+      if (m.zoom_axis < 0 || *ch.zoom < m.zoom_min - 1e-9 || *ch.zoom > m.zoom_max + 1e-9)
+        fail(ch, "zoom", "the microscope pedal zooms " + std::to_string(m.zoom_min) + " .. " + std::to_string(m.zoom_max));
+      axes[0] = (*ch.zoom - m.zoom_min) / std::max(m.zoom_max - m.zoom_min, 1e-9);
+      zoom = *ch.zoom;
+    }
+    if (ch.focus_mm) {
+      if (m.focus_axis < 0 || std::abs(*ch.focus_mm) > 0.5 * m.focus_range_mm + 1e-9)
+        fail(ch, "focus_mm", "the microscope pedal focuses ±" + std::to_string(0.5 * m.focus_range_mm) + " mm");
+      axes[1] = 0.5 + *ch.focus_mm / m.focus_range_mm;
+    }
+    key(ch.t_s * 1e3 + 1.0);
+    if (ch.look_at) {
+      if (m.pan_x_axis < 0 || m.pan_y_axis < 0) fail(ch, "look_at", "the pedal mapping has no X–Y joystick");
+      // As far as the microscope reaches: its field's centre stays within pan_travel_mm of the pole.
+      core::Vec2 to = *ch.look_at;
+      if (to.norm() > settings.pan_travel_mm) to *= settings.pan_travel_mm / to.norm();
+      const core::Vec2 d = to - centre;
+      const double dist = d.norm(), speed = settings.pan_speed_mm_s / zoom;
+      if (dist > 1e-6) {
+        // Each axis deflected by the direction's component, past the joystick's dead band.
+        const core::Vec2 dir = d / dist;
+        for (int k = 0; k < 2; ++k) {
+          const double q = dir[k], raw = q == 0.0 ? 0.0 : std::copysign(m.pan_deadband + std::abs(q) * (1.0 - m.pan_deadband), q);
+          axes[2 + k] = 0.5 + 0.5 * raw;
+        }
+        // Held from start to end (the emulator interpolates between keys: a key each side of a change).
+        const double start_ms = last_ms + 1.0, end_ms = start_ms + 1e3 * dist / speed;
+        key(start_ms);
+        key(end_ms - 0.5);
+        axes[2] = axes[3] = 0.5;
+        key(end_ms + 0.5);
+        pan_ends_s = end_ms * 1e-3;
+        centre = to;
+      }
+    }
+  }
+  key(std::max(last_ms + 1.0, script.duration_s * 1e3));
+  return "device pedals\nrate_hz 500\nserial 2101\npedal_id " + std::to_string(m.microscope_pedal_id) + "\naxes 4\nloop 0\nseed " +
+         std::to_string(script.seed + 30) + "\n" + keys;
+}
+
 // The pedal's state as the emulator plays it: two axes and a switch word.
 struct PedalState {
   double vacuum = 0.0, cut_rate = 0.0;
@@ -413,7 +503,15 @@ struct PedalState {
 
 }  // namespace
 
-ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals) {
+bool works_microscope(const SurgicalScript& script) {
+  for (const ScriptHand& h : script.hands)
+    for (const ScriptWaypoint& w : h.waypoints)
+      if (w.zoom || w.focus_mm || w.look_at) return true;
+  return false;
+}
+
+ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals,
+                              const core::MicroscopeSettings& microscope) {
   const core::Scene& scene = *c.scene;
   if (script.kind == "calibration")
     throw std::runtime_error(script.file + ": script.kind: a calibration script is a technician's, played by vitreo-calibrate --technician-script");
@@ -438,6 +536,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     int line;
   };
   std::vector<PedalChange> changes;
+  std::vector<MicroscopeChange> microscope_changes;
   std::mt19937_64 rng(script.seed * 7919 + 17);
   std::normal_distribution<double> tremor(0.0, 1.0);
 
@@ -475,6 +574,14 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       const std::string key = hand_key + ".waypoint[" + std::to_string(i) + "]";
       if (w.at_s && *w.at_s > t) add_segment(pos, jaws, *w.at_s - t, std::nullopt);  // wait in place
       PedalChange ch{t, w.vacuum, w.cut_rate, w.laser, w.reflux, w.air, 0, w.pick, w.line};
+      // The microscope from the waypoint's start on; look_at = "target" centres the field on where
+      // this waypoint goes (known below, once its target is).
+      std::optional<MicroscopeChange> mc;
+      if (w.zoom || w.focus_mm || w.look_at) {
+        mc = MicroscopeChange{t, w.zoom, w.focus_mm, std::nullopt, w.line, key};
+        if (w.look_at && *w.look_at != "target")
+          mc->look_at = scene.eye.fundus_coords(landmarks.resolve(*w.look_at, hand.tracker, w.look_at_line, key + ".look_at").at);
+      }
       if (w.tool) {
         const auto it = std::find(tools.begin(), tools.end(), *w.tool);
         if (it == tools.end()) landmarks.fail(w.tool_line, key + ".tool", "the case offers no " + *w.tool + " to the working hand");
@@ -510,6 +617,10 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
         const double wall_r = scene.eye.wall.radius_toward(d.normalized());
         if (d.norm() > wall_r + 0.3) landmarks.fail(w.to_line, key, "unreachable: " + std::to_string(d.norm() - wall_r) + " mm beyond the eye wall");
         if ((target - port.position_mm).norm() > 32.0) landmarks.fail(w.to_line, key, "unreachable: farther than a 32 mm shaft from the port");
+      }
+      if (mc) {
+        if (w.look_at && *w.look_at == "target") mc->look_at = scene.eye.fundus_coords(target);
+        microscope_changes.push_back(*mc);
       }
       const double dist = (target - pos).norm();
       const double speed = w.speed_mm_s.value_or(hand.speed_mm_s) * script.speed_scale;
@@ -576,6 +687,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
   }
   pedal_key(std::max(last_ms + 1.0, script.duration_s * 1e3), st);
   out.device_scripts["pedals"] = "device pedals\nrate_hz 500\nserial 2001\nloop 0\nseed " + std::to_string(script.seed + 10) + "\n" + pkeys;
+  if (!microscope_changes.empty()) out.device_scripts[kMicroscopePedalDevice] = microscope_pedal_script(microscope_changes, c, pedals, microscope, script);
   out.device_scripts["eyeball"] = "device eyeball\nrate_hz 250\nserial 3001\nloop 0\nseed " + std::to_string(script.seed + 20) +
                                   "\nkey 0 0 0 0 0 0\nkey " + std::to_string(static_cast<long>(script.duration_s * 1e3) + 1) + " 0 0 0 0 0\n";
   for (const ScriptFault& f : script.faults) {

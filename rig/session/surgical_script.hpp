@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/common/types.hpp"
+#include "core/scene/microscope.hpp"
 #include "rig/input/controls.hpp"
 #include "rig/session/case_runtime.hpp"
 
@@ -50,6 +51,13 @@ struct ScriptWaypoint {
   std::optional<double> cut_rate;  // 0..1 of the side travel
   std::optional<bool> laser, reflux, air;
   std::optional<bool> pick;  // the light pipe's pick out (its own pedal switch)
+  // The microscope pedal from this waypoint's start on: zoom (within the pedal mapping's zoom_min ..
+  // zoom_max), focus (mm about the fundus), and `look_at`, a landmark the field's centre is driven to
+  // with the joystick — deflected toward it for as long as the microscope's pan speed at the zoom in
+  // force needs, then let go; "target" is where this waypoint's tip goes.
+  std::optional<double> zoom, focus_mm;
+  std::optional<std::string> look_at;
+  int look_at_line = 0;
   // Calibration scripts only (kind = "calibration": a technician's hand, free of any port;
   // rig/calibration/README.md): the shaft's tilt from the fixture's vertical on arrival, a swing of
   // the handle about the resting tip during the hold (tilt growing from the first to the second
@@ -99,7 +107,8 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
 SurgicalScript read_surgical_script(const std::string& path);
 
 // The script as the simulated devices play it: one emulator script per device name ("tracker-0",
-// "tracker-1" when the second hand is scripted, "pedals", "eyeball").
+// "tracker-1" when the second hand is scripted, "pedals", "eyeball", and "microscope-pedal" when the
+// script works the microscope).
 struct ResolvedScript {
   std::map<std::string, std::string> device_scripts;
   double duration_s = 0.0;
@@ -111,6 +120,13 @@ struct ResolvedScript {
 // Landmarks: port (the hand's own), fovea, disc, roi (the case's region of interest),
 // membrane.NAME[.centre|.edge|.mid|.far_edge|.disc_edge], tear.NAME[.flap|.hinge],
 // detachment.NAME, guide.NAME[.start|.end|.N] (N: the guide's N-th point).
-ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals);
+// `microscope`: the settings the session's microscope runs with (its pan speed times look_at's joystick).
+ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals,
+                              const core::MicroscopeSettings& microscope = {});
+
+// The simulated microscope pedal's device name, and whether a script works the microscope (then
+// the scripted rig has that pedal too).
+inline constexpr const char* kMicroscopePedalDevice = "microscope-pedal";
+bool works_microscope(const SurgicalScript& script);
 
 }  // namespace vitreo::rig

@@ -17,7 +17,7 @@ using core::Vec3;
 constexpr double kSettle = 0.15;     // s cut off each end of a hold: the hand settling, then leaving
 constexpr double kKeyPeriod = 0.05;  // s between keys while the handle swings or the hand trembles
 
-struct Landmark {
+struct FixtureLandmark {
   Vec3 at = Vec3::Zero();
   StepKind kind = StepKind::clock;  // what a hold here can record (clock: nothing)
   int index = 0;
@@ -60,7 +60,7 @@ class Resolver {
     throw std::runtime_error(s_.file + ":" + std::to_string(line) + ": " + key + ": " + why);
   }
 
-  Landmark landmark(const std::string& name, int line, const std::string& key) const {
+  FixtureLandmark landmark(const std::string& name, int line, const std::string& key) const {
     if (name == "rest") return {f_.rest_mm, StepKind::clock, 0};
     if (name == "divot") return {f_.divot_mm, StepKind::pivot, 0};
     const auto dot = name.find('.');
@@ -136,7 +136,7 @@ calibration::Procedure resolve_technician_script(const SurgicalScript& script, c
         t = *w.at_s;
         keys.tracker(t, pos, 0.0, tilt, 0.0);
       }
-      const Landmark l = resolver.landmark(w.to, w.to_line, key + ".to");
+      const FixtureLandmark l = resolver.landmark(w.to, w.to_line, key + ".to");
       const Vec3 target = l.at + w.offset_mm;
       const double speed = w.speed_mm_s.value_or(hand.speed_mm_s) * script.speed_scale;
       const double move = w.duration_s ? *w.duration_s / script.speed_scale : (target - pos).norm() / speed;

@@ -67,6 +67,24 @@ TEST(EmulatorImperfections, PedalsReadTheirPotentiometersRange) {
   EXPECT_NEAR(m.u.pedal.axes[1] / 65535.0, 0.8, 1e-4);
 }
 
+// A second pedal (the microscope's): its id and four axes on the wire, decoded by the protocol's C
+// decoder; the switch word after the last axis.
+TEST(EmulatorImperfections, APedalNamesItsIdAndItsAxes) {
+  FirmwareEmulator emu(parse("device pedals\npedal_id 1\naxes 4\nloop 0\nkey 0 0.25 0.5 0.75 1 5\n"));
+  const vp_message m = first_sample(emu, VP_MSG_PEDAL_STATE);
+  EXPECT_EQ(m.u.pedal.pedal_id, 1);
+  EXPECT_EQ(m.u.pedal.axis_count, 4);
+  for (int a = 0; a < 4; ++a) EXPECT_NEAR(m.u.pedal.axes[a] / 65535.0, 0.25 * (a + 1), 1e-4) << a;
+  EXPECT_EQ(m.u.pedal.switches, 5);
+  Script s;
+  std::string err;
+  EXPECT_FALSE(parse_script("device pedals\nkey 0 0 0 0\naxes 4\n", s, &err));
+  EXPECT_NE(err.find("line 3: axes must come before the first key"), std::string::npos) << err;
+  EXPECT_FALSE(parse_script("device pedals\naxes 4\nkey 0 0 0 0\n", s, &err)) << "a four-axis key has five values";
+  EXPECT_FALSE(parse_script("device pedals\naxes 5\nkey 0 0 0 0\n", s, &err));
+  EXPECT_NE(err.find("axes must be 1..4"), std::string::npos) << err;
+}
+
 TEST(EmulatorImperfections, ClockOffsetAndDriftShowInTimeSync) {
   const std::string base = "device eyeball\nkey 0 0 0 0 0 0\n";
   FirmwareEmulator ideal(parse(base)), skewed(parse(base + "clock_offset_ms 123.5\nclock_drift_ppm 250\n"));

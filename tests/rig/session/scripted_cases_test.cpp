@@ -75,7 +75,7 @@ Played play(const std::string& case_name, const fs::path& script_file, const std
   config.model.load.retina_vertices = retina_vertices;
   config.model.load.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
   config.devices = simulated_devices(out.script);
-  config.adapt_devices = play_script(out.script, config.model.pedals);
+  config.adapt_devices = play_script(out.script, config.model.pedals, config.model.microscope);
   config.device_mode = HubMode::lockstep;
   config.unpaced = true;
   config.steps = static_cast<std::uint64_t>(std::llround(out.script.duration_s / config.model.dt_s));
@@ -164,6 +164,11 @@ void check_case(const std::string& name, int vertices) {
   EXPECT_TRUE(expert.summary.case_completed) << name << ": the expert script does not complete the case";
   EXPECT_EQ(expert.summary.totals.retina_tears, 0u);
   EXPECT_GT(expert.summary.score.total, idle.summary.score.total);
+  // An expert that works the microscope (look_at, zoom, focus: the scripted rig's microscope pedal)
+  // keeps the work in the field, centred and in focus.
+  if (works_microscope(read_surgical_script(script_path(name, "expert").string()))) {
+    EXPECT_GT(category(expert.summary, "microscope_handling"), 80.0) << name << ": its expert's field does not follow the work";
+  }
   check_report(expert);
 
   if (!have_clumsy) GTEST_SKIP() << name << ": the expert completes; no clumsy script yet";

@@ -9,6 +9,8 @@
 
 #include "drivers/sim/emulator.hpp"
 #include "rig/scene_io/case_loader.hpp"
+#include "core/scene/microscope.hpp"
+#include "rig/input/controls.hpp"
 #include "rig/session/surgical_script.hpp"
 
 namespace vitreo::rig {
@@ -234,6 +236,91 @@ TEST_F(Resolving, PedalsAndToolSwitchesFollowTheWaypoints) {
   drivers::sim::Script hand;
   ASSERT_TRUE(drivers::sim::parse_script(r.device_scripts.at("tracker-0"), hand, &err)) << err;
   EXPECT_EQ(hand.tool, 0);
+}
+
+}  // namespace
+}  // namespace vitreo::rig
+
+namespace vitreo::rig {
+namespace {
+
+// The microscope pedal a script works, played key by key (linearly between keys, as the emulator
+// plays them) through the rig's own pedal mapping into the core's microscope, 1 ms a step: where
+// the field's centre, the zoom and the focus end up — checked against the landmark's place on the
+// fundus, not against the resolver's arithmetic.
+struct MicroscopeEnd {
+  core::Vec2 centre;
+  double zoom, focus;
+};
+MicroscopeEnd play_microscope_pedal(const std::string& emulator_script, const PreparedCase& c, double seconds) {
+  drivers::sim::Script s;
+  std::string err;
+  EXPECT_TRUE(drivers::sim::parse_script(emulator_script, s, &err)) << err;
+  EXPECT_EQ(s.pedal_id, 1);
+  EXPECT_EQ(s.pedal_axes, 4);
+  PedalMapper mapper;
+  core::MicroscopeSettings settings;
+  core::Microscope microscope(settings, c.scene->eye.fundus_coords(c.focus_mm));
+  for (int k = 0; k < static_cast<int>(seconds * 1000); ++k) {
+    const auto t_us = static_cast<std::uint64_t>(k) * 1000;
+    std::vector<double> v = s.keys.back().second;
+    for (std::size_t i = 0; i + 1 < s.keys.size(); ++i) {
+      if (t_us >= s.keys[i].first && t_us < s.keys[i + 1].first) {
+        const double f = static_cast<double>(t_us - s.keys[i].first) / static_cast<double>(s.keys[i + 1].first - s.keys[i].first);
+        for (std::size_t j = 0; j < v.size(); ++j) v[j] = s.keys[i].second[j] + f * (s.keys[i + 1].second[j] - s.keys[i].second[j]);
+        break;
+      }
+    }
+    const SurgicalControls before = mapper.controls();
+    PedalReading r;
+    r.pedal_id = 1;
+    r.axis_count = 4;
+    for (int a = 0; a < 4; ++a) r.axes[a] = v[static_cast<std::size_t>(a)];
+    EXPECT_TRUE(mapper.apply(r));
+    if (mapper.controls().zoom != before.zoom) microscope.set_zoom(mapper.controls().zoom);
+    if (mapper.controls().focus_offset_mm != before.focus_offset_mm) microscope.set_focus(mapper.controls().focus_offset_mm);
+    microscope.step(0.001, core::MicroscopeInput{core::Vec2(mapper.controls().pan_x, mapper.controls().pan_y)});
+  }
+  return {microscope.center_mm(), microscope.zoom(), microscope.focus_mm()};
+}
+
+TEST_F(Resolving, AScriptWorksTheMicroscopeAndLookAtCentresTheFieldOnItsLandmark) {
+  const std::string text = std::string(kHead) +
+                           "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\nzoom = 2.0\nduration_s = 0.5\n"
+                           "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.5\nlook_at = \"disc\"\nduration_s = 0.5\n"
+                           "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\nat_s = 3.0\nfocus_mm = 1.0\n";
+  const SurgicalScript script = parse_surgical_script(text, "m.toml");
+  EXPECT_TRUE(works_microscope(script));
+  const ResolvedScript r = resolve_script(script, *case_, PedalMapping{});
+  ASSERT_TRUE(r.device_scripts.count(kMicroscopePedalDevice));
+  const MicroscopeEnd end = play_microscope_pedal(r.device_scripts.at(kMicroscopePedalDevice), *case_, 4.0);
+  const core::Vec2 disc = case_->scene->eye.fundus_coords(case_->scene->eye.optic_disc_mm);
+  const core::Vec2 start = case_->scene->eye.fundus_coords(case_->focus_mm);
+  std::printf("field centre from (%.3f, %.3f) to (%.3f, %.3f) mm; the disc at (%.3f, %.3f) mm; zoom %.2f, focus %.2f mm\n", start.x(),
+              start.y(), end.centre.x(), end.centre.y(), disc.x(), disc.y(), end.zoom, end.focus);
+  EXPECT_GT((disc - start).norm(), 2.0) << "a pan worth testing";
+  EXPECT_LT((end.centre - disc).norm(), 0.05) << "the field's centre on the disc";
+  EXPECT_NEAR(end.zoom, 2.0, 1e-3);
+  EXPECT_NEAR(end.focus, 1.0, 1e-3);
+  // A script that leaves the microscope alone has no microscope pedal.
+  EXPECT_FALSE(works_microscope(parse_surgical_script(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n", "n.toml")));
+  EXPECT_FALSE(resolve_script(parse_surgical_script(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n", "n.toml"), *case_,
+                              PedalMapping{})
+                   .device_scripts.count(kMicroscopePedalDevice));
+}
+
+TEST_F(Resolving, MicroscopeChangesTheRigCannotMakeAreRefusedWithLineAndKey) {
+  EXPECT_EQ(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nzoom = 9.0\n"),
+            "r.toml:6: hand[0].waypoint[0].zoom: the microscope pedal zooms 1.000000 .. 4.000000");
+  EXPECT_EQ(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nfocus_mm = 3.5\n"),
+            "r.toml:6: hand[0].waypoint[0].focus_mm: the microscope pedal focuses ±3.000000 mm");
+  EXPECT_NE(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nlook_at = \"macula_hole\"\n")
+                .find("r.toml:8: hand[0].waypoint[0].look_at: unknown landmark 'macula_hole'"),
+            std::string::npos);
+  EXPECT_NE(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nlook_at = \"disc\"\n"
+                                               "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 1.0\nduration_s = 0.1\nzoom = 2.0\n")
+                .find("r.toml:9: hand[0].waypoint[1].look_at: the field is still panning"),
+            std::string::npos);
 }
 
 }  // namespace
