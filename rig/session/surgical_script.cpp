@@ -181,6 +181,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         p.pick = w.boolean("pick");
         p.zoom = w.number("zoom", 0.1, 40);
         p.focus_mm = w.number("focus_mm", -20, 20);
+        p.light = w.number("light", 0, 1);
         p.look_at = w.string("look_at");
         if (p.look_at) p.look_at_line = line_of(*w.get("look_at"));
         p.tilt_deg = w.number("tilt_deg", -80, 80);
@@ -207,10 +208,10 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
         for (const char* k : {"tilt_deg", "swing_deg", "swing_period_s", "records", "travel"})
           if (!calibration && w.get(k)) w.fail(*w.get(k), k, "only in calibration scripts (kind = \"calibration\")");
         for (const char* k : {"above_mm", "toward_port_mm", "across_mm", "standoff_mm", "jaws", "roll_deg", "tool", "vacuum", "cut_rate",
-                              "laser", "reflux", "air", "pick", "zoom", "focus_mm", "look_at"})
+                              "laser", "reflux", "air", "pick", "zoom", "focus_mm", "light", "look_at"})
           if (calibration && w.get(k))
             w.fail(*w.get(k), k, "not in a calibration script (no case, no port, no tool; the pedals are pressed by `records = \"pedal_travel.AXIS\"`)");
-        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick, zoom, focus_mm, look_at, tilt_deg, swing_deg, swing_period_s, records, travel");
+        w.refuse_unknown("to, above_mm, toward_port_mm, across_mm, offset_mm, standoff_mm, at_s, speed_mm_s, duration_s, hold_s, jaws, roll_deg, tool, vacuum, cut_rate, laser, reflux, air, pick, zoom, focus_mm, light, look_at, tilt_deg, swing_deg, swing_period_s, records, travel");
         h.waypoints.push_back(std::move(p));
       }
       r.refuse_unknown("tracker, speed_mm_s, waypoint");
@@ -412,14 +413,14 @@ std::string tracker_key(double t_ms, const Vec3& p, double jaws, const Vec3& eul
 // A change of the microscope pedal a waypoint asks for, from its start on.
 struct MicroscopeChange {
   double t_s;
-  std::optional<double> zoom, focus_mm;
+  std::optional<double> zoom, focus_mm, light;
   std::optional<core::Vec2> look_at;  // fundus plane: where the field's centre goes
   int line;
   std::string key;
 };
 
 // The simulated microscope pedal's emulator script: zoom and focus axes set to what each change
-// asks, the joystick deflected toward each look_at target for as long as the pan takes at the
+// asks, the light switches pressed as many times as the light's steps need, the joystick deflected toward each look_at target for as long as the pan takes at the
 // zoom then in force (core::Microscope: pan_speed_mm_s / zoom at full deflection), then let go; a
 // target beyond the microscope's reach takes the field as far as it goes (its centre stays within
 // pan_travel_mm of the posterior pole). Open loop like the rest
@@ -432,18 +433,18 @@ std::string microscope_pedal_script(std::vector<MicroscopeChange> changes, const
   };
   std::stable_sort(changes.begin(), changes.end(), [](const MicroscopeChange& a, const MicroscopeChange& b) { return a.t_s < b.t_s; });
   double axes[4] = {0.0, 0.5, 0.5, 0.5};  // by role: zoom travel, focus travel, joystick x, y (centred)
-  double zoom = m.zoom_min;
+  double zoom = m.zoom_min, light = SurgicalControls{}.light_level;
   core::Vec2 centre = c.scene->eye.fundus_coords(c.focus_mm);  // the microscope starts on the region of interest
   std::string keys;
   double last_ms = -1.0;
-  auto key = [&](double t_ms) {
+  auto key = [&](double t_ms, unsigned switches = 0) {
     t_ms = std::max(t_ms, last_ms + 0.5);
     double v[4] = {0.0, 0.0, 0.0, 0.0};
     const int index[4] = {m.zoom_axis, m.focus_axis, m.pan_x_axis, m.pan_y_axis};
     for (int r = 0; r < 4; ++r)
       if (index[r] >= 0 && index[r] < 4) v[index[r]] = axes[r];
     char b[128];
-    std::snprintf(b, sizeof b, "key %.1f %.6f %.6f %.6f %.6f 0\n", t_ms, v[0], v[1], v[2], v[3]);
+    std::snprintf(b, sizeof b, "key %.1f %.6f %.6f %.6f %.6f %u\n", t_ms, v[0], v[1], v[2], v[3], switches);
     keys += b;
     last_ms = t_ms;
   };
@@ -465,6 +466,20 @@ std::string microscope_pedal_script(std::vector<MicroscopeChange> changes, const
       axes[1] = 0.5 + *ch.focus_mm / m.focus_range_mm;
     }
     key(ch.t_s * 1e3 + 1.0);
+    if (ch.light) {
+      // The light source in its steps: a press (50 ms down, 50 ms up) of the up or down switch each.
+      const int presses = static_cast<int>(std::lround((*ch.light - light) / m.light_step));
+      const int sw = presses > 0 ? m.light_up_switch : m.light_down_switch;
+      if (presses != 0 && (sw < 0 || sw > 15 || !(m.light_step > 0.0))) fail(ch, "light", "the pedal mapping has no light switch");
+      for (int k = 0; k < std::abs(presses); ++k) {
+        const double at = last_ms + 1.0;
+        key(at, 1u << sw);
+        key(at + 49.0, 1u << sw);
+        key(at + 50.0);
+        key(at + 99.0);
+      }
+      light = std::clamp(light + presses * m.light_step, 0.0, 1.0);
+    }
     if (ch.look_at) {
       if (m.pan_x_axis < 0 || m.pan_y_axis < 0) fail(ch, "look_at", "the pedal mapping has no X–Y joystick");
       // As far as the microscope reaches: its field's centre stays within pan_travel_mm of the pole.
@@ -506,7 +521,7 @@ struct PedalState {
 bool works_microscope(const SurgicalScript& script) {
   for (const ScriptHand& h : script.hands)
     for (const ScriptWaypoint& w : h.waypoints)
-      if (w.zoom || w.focus_mm || w.look_at) return true;
+      if (w.zoom || w.focus_mm || w.light || w.look_at) return true;
   return false;
 }
 
@@ -577,8 +592,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       // The microscope from the waypoint's start on; look_at = "target" centres the field on where
       // this waypoint goes (known below, once its target is).
       std::optional<MicroscopeChange> mc;
-      if (w.zoom || w.focus_mm || w.look_at) {
-        mc = MicroscopeChange{t, w.zoom, w.focus_mm, std::nullopt, w.line, key};
+      if (w.zoom || w.focus_mm || w.light || w.look_at) {
+        mc = MicroscopeChange{t, w.zoom, w.focus_mm, w.light, std::nullopt, w.line, key};
         if (w.look_at && *w.look_at != "target")
           mc->look_at = scene.eye.fundus_coords(landmarks.resolve(*w.look_at, hand.tracker, w.look_at_line, key + ".look_at").at);
       }

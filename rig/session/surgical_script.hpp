@@ -56,6 +56,7 @@ struct ScriptWaypoint {
   // with the joystick — deflected toward it for as long as the microscope's pan speed at the zoom in
   // force needs, then let go; "target" is where this waypoint's tip goes.
   std::optional<double> zoom, focus_mm;
+  std::optional<double> light;  // the light source's level 0..1, by the pedal's light switches (its steps)
   std::optional<std::string> look_at;
   int look_at_line = 0;
   // Calibration scripts only (kind = "calibration": a technician's hand, free of any port;

@@ -250,7 +250,7 @@ namespace {
 // fundus, not against the resolver's arithmetic.
 struct MicroscopeEnd {
   core::Vec2 centre;
-  double zoom, focus;
+  double zoom, focus, light;
 };
 MicroscopeEnd play_microscope_pedal(const std::string& emulator_script, const PreparedCase& c, double seconds) {
   drivers::sim::Script s;
@@ -268,6 +268,7 @@ MicroscopeEnd play_microscope_pedal(const std::string& emulator_script, const Pr
       if (t_us >= s.keys[i].first && t_us < s.keys[i + 1].first) {
         const double f = static_cast<double>(t_us - s.keys[i].first) / static_cast<double>(s.keys[i + 1].first - s.keys[i].first);
         for (std::size_t j = 0; j < v.size(); ++j) v[j] = s.keys[i].second[j] + f * (s.keys[i + 1].second[j] - s.keys[i].second[j]);
+        v[4] = s.keys[i].second[4];  // switches are held from the earlier key, not blended
         break;
       }
     }
@@ -276,19 +277,20 @@ MicroscopeEnd play_microscope_pedal(const std::string& emulator_script, const Pr
     r.pedal_id = 1;
     r.axis_count = 4;
     for (int a = 0; a < 4; ++a) r.axes[a] = v[static_cast<std::size_t>(a)];
+    r.switches = static_cast<std::uint16_t>(v[4]);
     EXPECT_TRUE(mapper.apply(r));
     if (mapper.controls().zoom != before.zoom) microscope.set_zoom(mapper.controls().zoom);
     if (mapper.controls().focus_offset_mm != before.focus_offset_mm) microscope.set_focus(mapper.controls().focus_offset_mm);
     microscope.step(0.001, core::MicroscopeInput{core::Vec2(mapper.controls().pan_x, mapper.controls().pan_y)});
   }
-  return {microscope.center_mm(), microscope.zoom(), microscope.focus_mm()};
+  return {microscope.center_mm(), microscope.zoom(), microscope.focus_mm(), mapper.controls().light_level};
 }
 
 TEST_F(Resolving, AScriptWorksTheMicroscopeAndLookAtCentresTheFieldOnItsLandmark) {
   const std::string text = std::string(kHead) +
                            "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\nzoom = 2.0\nduration_s = 0.5\n"
                            "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.5\nlook_at = \"disc\"\nduration_s = 0.5\n"
-                           "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\nat_s = 3.0\nfocus_mm = 1.0\n";
+                           "[[hand.waypoint]]\nto = \"port\"\nabove_mm = 3.0\nat_s = 3.0\nfocus_mm = 1.0\nlight = 0.4\n";
   const SurgicalScript script = parse_surgical_script(text, "m.toml");
   EXPECT_TRUE(works_microscope(script));
   const ResolvedScript r = resolve_script(script, *case_, PedalMapping{});
@@ -302,6 +304,7 @@ TEST_F(Resolving, AScriptWorksTheMicroscopeAndLookAtCentresTheFieldOnItsLandmark
   EXPECT_LT((end.centre - disc).norm(), 0.05) << "the field's centre on the disc";
   EXPECT_NEAR(end.zoom, 2.0, 1e-3);
   EXPECT_NEAR(end.focus, 1.0, 1e-3);
+  EXPECT_NEAR(end.light, 0.4, 1e-9) << "three presses of the light's down switch from 0.7";
   // A script that leaves the microscope alone has no microscope pedal.
   EXPECT_FALSE(works_microscope(parse_surgical_script(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n", "n.toml")));
   EXPECT_FALSE(resolve_script(parse_surgical_script(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"port\"\n", "n.toml"), *case_,
