@@ -24,8 +24,10 @@ constexpr double kRestS = 1.2;              // eye and pedals left alone this lo
 constexpr double kHoldS = 0.4;              // a touch held still this long…
 constexpr double kHoldRmsMm = 0.10;         // …within this RMS (0.05 mm of tracker noise per axis alone gives 0.087)
 constexpr double kTouchApartMm = 2.0;       // and this far from the last point taken
-constexpr std::size_t kPivotPoses = 3000;   // the pivot: this many poses…
+constexpr double kPivotS = 3.0;             // the pivot: this long…
+constexpr std::size_t kPivotPoses = 300;    // …with at least this many poses (a loaded machine hands over fewer)…
 constexpr double kPivotSpreadDeg = 40.0;    // …this widely spread, with a sound fit
+constexpr std::size_t kHoldPoses = 20;      // a touch's hold: at least this many poses in its 0.4 s
 constexpr double kPressDepth = 0.3;         // a pedal press: down at least this much of its raw reading…
 constexpr double kPressBack = 0.03;         // …and back within this of its lowest for 0.2 s
 constexpr double kFeedbackPeriodS = 0.5;
@@ -95,14 +97,11 @@ GuidedOutcome run_guided_calibration(const RigFile& rig, const std::vector<Proce
   hub.start();
   const std::int64_t t0 = static_cast<std::int64_t>(hub.now_us());
   auto now_s = [&] { return static_cast<double>(static_cast<std::int64_t>(hub.now_us()) - t0) * 1e-6; };
-  std::map<std::string, double> last_t;  // each device's samples in time order
+  // Samples are timed when this loop takes them, on the clock the steps' windows are cut by, so a
+  // window never misses a sample it has already seen (the drivers' own stamps can run ahead of it).
   auto pump = [&] {
-    hub.take_new([&](const telemetry::RecordedInput& in) {
-      const std::string& name = name_of[in.device_id];
-      double& last = last_t[name];
-      last = std::max(last, static_cast<double>(in.host_time_us - t0) * 1e-6);
-      record_calibration_input(session, name, last, in, out);
-    });
+    const double at = now_s();
+    hub.take_new([&](const telemetry::RecordedInput& in) { record_calibration_input(session, name_of[in.device_id], at, in, out); });
   };
   LineInput input(input_fd);
   // Waits for the technician's line, reading the devices meanwhile; nothing when the input ended.
@@ -196,7 +195,7 @@ GuidedOutcome run_guided_calibration(const RigFile& rig, const std::vector<Proce
               tip_offset[s.device] = r.tip_offset_mm;
               last_point[s.device] = r.pivot_mm;
             }
-            ended = ended || (r.ok && taken >= kPivotPoses && r.spread_deg >= kPivotSpreadDeg);
+            ended = ended || (r.ok && t - s.start_s >= kPivotS && taken >= kPivotPoses && r.spread_deg >= kPivotSpreadDeg);
             break;
           }
           case StepKind::fiducial:
@@ -209,7 +208,7 @@ GuidedOutcome run_guided_calibration(const RigFile& rig, const std::vector<Proce
             std::vector<core::Vec3> tips;
             for (auto it = rec.poses[s.device].rbegin(); it != rec.poses[s.device].rend() && it->t_s >= t - kHoldS; ++it)
               tips.push_back(it->position_mm + it->orientation.normalized() * offset->second);
-            if (tips.size() < 50 || t - kHoldS < s.start_s) {
+            if (tips.size() < kHoldPoses || t - kHoldS < s.start_s) {
               live = "moving";
               break;
             }
