@@ -50,17 +50,22 @@ check "the rig runs with it and its summary names it" '[ $rc -eq 0 ] && grep -q 
 check "the rig pins the calibrated units" 'grep -q "tracker-0 must announce serial 1001" "$dir/run.out"'
 check "the recording carries it and replays to the same state" 'grep -q "identical final state" "$dir/run.out" && grep -aq "^calibration [0-9]" "$dir/run/session.lcmlog"'
 
+# These processes render: at exit eglTerminate unloads Mesa's software driver and LeakSanitizer
+# reports its once-per-process allocations as "<unknown module>" leaks no suppression can name
+# (tests/rig/report/make_session.sh says the same; the render tests check our rendering for leaks
+# in-process with the driver pinned). Leaks are not checked in these four runs only.
+render_env() { ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" "$@"; }
 cp "$dir/cal.toml" "$dir/eye.toml"
-printf 'right 3 -2\nbogus\nshow\ndone\n' | "$CAL" --eyepieces --out "$dir/eye.toml" --pattern-png "$dir/pattern" --eye-size 320 > "$dir/eye.out" 2>&1; rc=$?
+printf 'right 3 -2\nbogus\nshow\ndone\n' | render_env "$CAL" --eyepieces --out "$dir/eye.toml" --pattern-png "$dir/pattern" --eye-size 320 > "$dir/eye.out" 2>&1; rc=$?
 check "the eyepiece calibration writes its table and keeps the rest of the file" '[ $rc -eq 0 ] && grep -qx "right_offset_px = \[3.00, -2.00\]" "$dir/eye.toml" && diff <(grep -v "^created\|^tool\|^#\|^$" "$dir/cal.toml") <(sed "/^\[eyepieces\]/,/^convergence_mm/d" "$dir/eye.toml" | grep -v "^created\|^tool\|^#\|^$") > /dev/null'
 check "it answered a malformed command and showed the pattern" 'grep -q "'"'"'bogus'"'"': left DX DY" "$dir/eye.out" && [ -s "$dir/pattern/eyepieces_stereo.png" ]'
 cp "$dir/eye.toml" "$dir/eye-before.toml"
-printf 'right 9 9\nq\n' | "$CAL" --eyepieces --out "$dir/eye.toml" > /dev/null 2>&1; rc=$?
+printf 'right 9 9\nq\n' | render_env "$CAL" --eyepieces --out "$dir/eye.toml" > /dev/null 2>&1; rc=$?
 check "giving up at the pattern changes nothing" '[ $rc -eq 3 ] && cmp -s "$dir/eye.toml" "$dir/eye-before.toml"'
 "$CAL" --from-recording "$dir/cal.recording" --out "$dir/eye.toml" > /dev/null 2>&1; rc=$?
 check "a sensor calibration written over the file keeps its eyepieces" '[ $rc -eq 0 ] && grep -qx "right_offset_px = \[3.00, -2.00\]" "$dir/eye.toml"'
-"$VITREO" --rig "$rig" --calibration "$dir/cal.toml" --duration 0.2 --eye-size 320 --no-verify --out "$dir/plain" > /dev/null 2>&1
-"$VITREO" --rig "$rig" --calibration "$dir/eye.toml" --duration 0.2 --eye-size 320 --no-verify --out "$dir/shifted" > "$dir/shifted.out" 2>&1; rc=$?
+render_env "$VITREO" --rig "$rig" --calibration "$dir/cal.toml" --duration 0.2 --eye-size 320 --no-verify --out "$dir/plain" > /dev/null 2>&1
+render_env "$VITREO" --rig "$rig" --calibration "$dir/eye.toml" --duration 0.2 --eye-size 320 --no-verify --out "$dir/shifted" > "$dir/shifted.out" 2>&1; rc=$?
 check "the rig says which eyepiece settings it applies" '[ $rc -eq 0 ] && grep -q "eyepiece displays: left image shifted (0.0, 0.0) px, right (3.0, -2.0) px" "$dir/shifted.out"'
 last_left=$(ls "$dir/plain/frames/"step_*_left.png | tail -1); last_right=${last_left%_left.png}_right.png
 check "its last frame: the left eye as without, the right eye moved" '[ -s "$last_left" ] && cmp -s "$last_left" "$dir/shifted/frames/$(basename "$last_left")" && ! cmp -s "$last_right" "$dir/shifted/frames/$(basename "$last_right")"'
