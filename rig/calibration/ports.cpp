@@ -5,6 +5,16 @@
 
 namespace vitreo::rig::calibration {
 
+HeldPoint held_point(const std::vector<core::Vec3>& tips) {
+  HeldPoint h;
+  for (const core::Vec3& p : tips) h.mean_mm += p;
+  h.mean_mm /= static_cast<double>(tips.size());
+  double sq = 0.0;
+  for (const core::Vec3& p : tips) sq += (p - h.mean_mm).squaredNorm();
+  h.spread_mm = std::sqrt(sq / static_cast<double>(tips.size()));
+  return h;
+}
+
 PortResult measure_port(const std::vector<core::Vec3>& tips, const PortLimits& limits) {
   PortResult r;
   r.samples = tips.size();
@@ -13,18 +23,15 @@ PortResult measure_port(const std::vector<core::Vec3>& tips, const PortLimits& l
               std::to_string(std::max<std::size_t>(limits.min_samples, 1)) + "); hold the tip in the trocar longer";
     return r;
   }
-  core::Vec3 sum = core::Vec3::Zero();
   for (const core::Vec3& p : tips) {
     if (!p.allFinite()) {
       r.error = "a tip sample is not finite";
       return r;
     }
-    sum += p;
   }
-  r.position_mm = sum / static_cast<double>(tips.size());
-  double sq = 0.0;
-  for (const core::Vec3& p : tips) sq += (p - r.position_mm).squaredNorm();
-  r.spread_mm = std::sqrt(sq / static_cast<double>(tips.size()));
+  const HeldPoint held = held_point(tips);
+  r.position_mm = held.mean_mm;
+  r.spread_mm = held.spread_mm;
   if (r.position_mm.norm() < 1e-6) {
     r.error = "the port measured at the globe centre; is the registration applied?";
     return r;

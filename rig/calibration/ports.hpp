@@ -24,6 +24,14 @@ struct PortResult {
   std::size_t samples = 0;
 };
 
+// Where a held tip was and how still: the samples' mean and their RMS distance from it (at least
+// one sample). A port, a touched fiducial and the guided procedure's "held still" all judge by it.
+struct HeldPoint {
+  core::Vec3 mean_mm = core::Vec3::Zero();
+  double spread_mm = 0.0;
+};
+HeldPoint held_point(const std::vector<core::Vec3>& tips);
+
 PortResult measure_port(const std::vector<core::Vec3>& tip_in_eye_mm, const PortLimits& limits = {});
 
 }  // namespace vitreo::rig::calibration

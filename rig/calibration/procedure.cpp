@@ -179,12 +179,9 @@ Analysis analyse(const Procedure& proc, const Fixture& fixture, const Recording&
                                 std::to_string(limits.port.min_samples) + "): did the tracker stop?");
           break;
         }
-        core::Vec3 mean = core::Vec3::Zero();
-        for (const core::Vec3& p : tips) mean += p;
-        mean /= static_cast<double>(tips.size());
-        double sq = 0.0;
-        for (const core::Vec3& p : tips) sq += (p - mean).squaredNorm();
-        const double spread = std::sqrt(sq / static_cast<double>(tips.size()));
+        const HeldPoint held = held_point(tips);
+        const core::Vec3& mean = held.mean_mm;
+        const double spread = held.spread_mm;
         const std::string fb = std::to_string(tips.size()) + " samples, held within " + (fixed(spread, 3) + " mm");
         if (s.kind == StepKind::fiducial) {
           const bool still = spread <= limits.port.max_spread_mm;

@@ -37,6 +37,16 @@ void record_calibration_input(calibration::CalibrationSession& session, const st
   }
 }
 
+void collect_time_syncs(DeviceHub& hub, calibration::Recording& rec, std::mutex& m) {
+  for (std::size_t i = 0; i < hub.device_count(); ++i) {
+    const std::string name = hub.name(i);
+    hub.on_time_sync(i, [&rec, &m, name](std::uint64_t t1, std::uint64_t t2, std::uint64_t t3, std::uint64_t t4) {
+      std::lock_guard lock(m);
+      rec.clocks[name].push_back({t1, t2, t3, t4});
+    });
+  }
+}
+
 CalibrationRoles calibration_roles(const RigFile& rig) {
   CalibrationRoles r;
   for (const DeviceSpec& d : rig.devices) {
@@ -84,13 +94,7 @@ calibration::CalibrationSession run_scripted_calibration(const RigFile& rig, con
   calibration::Recording& rec = session.recording;
   std::mutex clocks_mutex;  // time syncs arrive on the hub's driver thread
   DeviceHub hub(specs, nullptr, HubMode::lockstep);
-  for (std::size_t i = 0; i < hub.device_count(); ++i) {
-    const std::string name = hub.name(i);
-    hub.on_time_sync(i, [&rec, &clocks_mutex, name](std::uint64_t t1, std::uint64_t t2, std::uint64_t t3, std::uint64_t t4) {
-      std::lock_guard lock(clocks_mutex);
-      rec.clocks[name].push_back({t1, t2, t3, t4});
-    });
-  }
+  collect_time_syncs(hub, rec, clocks_mutex);
   hub.start();
   hub.lockstep_connect();
   // The file names the units it calibrated.

@@ -7,6 +7,7 @@
 // step, so it is reproducible and as fast as the machine. It prints each step as the technician
 // starts it, and every link fault.
 #include <cstdio>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,11 @@ CalibrationRoles calibration_roles(const RigFile& rig);
 // name; a link lost or stuck is a fault of the run, printed and kept in session.events).
 void record_calibration_input(calibration::CalibrationSession& session, const std::string& device, double t_s,
                               const telemetry::RecordedInput& in, std::FILE* progress);
+
+class DeviceHub;
+// Before hub.start(): every device's completed time-sync exchanges go into rec.clocks (on the
+// hub's driver thread, under `m`: read them after hub.stop() or under the same lock).
+void collect_time_syncs(DeviceHub& hub, calibration::Recording& rec, std::mutex& m);
 
 // The device's own emulator script with its motion ("key" and "loop" lines) replaced by `motion`.
 std::string with_technician_motion(const DeviceSpec& d, const std::string& motion);

@@ -87,13 +87,7 @@ GuidedOutcome run_guided_calibration(const RigFile& rig, const std::vector<Proce
 
   std::mutex clocks_mutex;  // time syncs arrive on the hub's driver thread
   DeviceHub hub(rig.devices, nullptr, HubMode::realtime);
-  for (std::size_t i = 0; i < hub.device_count(); ++i) {
-    const std::string name = hub.name(i);
-    hub.on_time_sync(i, [&rec, &clocks_mutex, name](std::uint64_t t1, std::uint64_t t2, std::uint64_t t3, std::uint64_t t4) {
-      std::lock_guard lock(clocks_mutex);
-      rec.clocks[name].push_back({t1, t2, t3, t4});
-    });
-  }
+  collect_time_syncs(hub, rec, clocks_mutex);
   hub.start();
   const std::int64_t t0 = static_cast<std::int64_t>(hub.now_us());
   auto now_s = [&] { return static_cast<double>(static_cast<std::int64_t>(hub.now_us()) - t0) * 1e-6; };
@@ -212,12 +206,9 @@ GuidedOutcome run_guided_calibration(const RigFile& rig, const std::vector<Proce
               live = "moving";
               break;
             }
-            core::Vec3 mean = core::Vec3::Zero();
-            for (const core::Vec3& p : tips) mean += p;
-            mean /= static_cast<double>(tips.size());
-            double sq = 0.0;
-            for (const core::Vec3& p : tips) sq += (p - mean).squaredNorm();
-            const double rms = std::sqrt(sq / static_cast<double>(tips.size()));
+            const calibration::HeldPoint held = calibration::held_point(tips);
+            const core::Vec3& mean = held.mean_mm;
+            const double rms = held.spread_mm;
             const auto last = last_point.find(s.device);
             const bool apart = last == last_point.end() || (mean - last->second).norm() >= kTouchApartMm;
             live = rms <= kHoldRmsMm ? (apart ? "held still" : "still on the last point: move to the next") : "moving (" + fixed(rms, 2) + " mm)";
