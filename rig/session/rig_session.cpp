@@ -255,6 +255,7 @@ SessionSummary run_session(const SessionConfig& config) {
   std::size_t switches = 0;
 
   int stopped_by = 0;                              // the signal that ended the session early (physics thread)
+  bool ended_at_case_over = false;                 // or the case's end (SessionConfig::end_at_case_over)
   // The step the current case ended at, -1 while it runs (physics writes, the telemetry service
   // announces it once); whether it ended complete or out of time.
   std::atomic<std::int64_t> case_over_step{-1};
@@ -266,7 +267,8 @@ SessionSummary run_session(const SessionConfig& config) {
     // A stop request (SIGINT/SIGTERM) makes this step the session's last: it is finished, the end
     // marker recorded, and nothing is cut off in the middle.
     const int stop = config.stop ? config.stop->load(std::memory_order_relaxed) : 0;
-    const bool last = k + 1 == config.steps || stop != 0;
+    const bool case_done = config.end_at_case_over && case_over_step.load(std::memory_order_relaxed) >= 0;
+    const bool last = k + 1 == config.steps || stop != 0 || case_done;
     if (config.on_step) config.on_step(k, hub);
     auto consume = [&](const telemetry::RecordedInput& in) {
       telemetry::RecordedInput stamped = in;
@@ -354,8 +356,9 @@ SessionSummary run_session(const SessionConfig& config) {
       if (capture_view(model, k, t_s, views.write_slot())) views.publish();
     }
     if (timing) timing->on_step(k, model.paused());  // 10 Hz, each message its own window (CHANNELS.md)
-    if (last && stop != 0) {
+    if (last && (stop != 0 || case_done)) {
       stopped_by = stop;
+      ended_at_case_over = stop == 0;
       loop->request_stop();
     }
   });
@@ -442,6 +445,7 @@ SessionSummary run_session(const SessionConfig& config) {
   summary.snapshots = snapshots.written();
 
   summary.steps = harness.loop().stats().steps;
+  if (ended_at_case_over) summary.stop_reason = "case over";
   if (stopped_by != 0) {
     summary.stop_reason = stopped_by == SIGINT ? "SIGINT" : stopped_by == SIGTERM ? "SIGTERM" : "signal " + std::to_string(stopped_by);
   }

@@ -43,6 +43,10 @@ struct SessionConfig {
   // Lockstep only: run physics as fast as it goes (no wall-clock pacing), for tests and batch
   // scoring; false paces it to real time where the machine keeps up (a demonstration).
   bool unpaced = false;
+  // Batch scoring (the scripted acceptance): the step after the case is over is the session's last —
+  // its score is frozen then, and stepping on would only play the rest of the script. The live rig
+  // and the main job keep running and offer the next case instead.
+  bool end_at_case_over = false;
   // Scripted actions at given steps, run on the physics thread (hardware-in-the-loop tests pull a
   // simulated cable with it). Must be quick and wait-free, like everything on that thread.
   std::function<void(std::uint64_t step, DeviceHub& hub)> on_step;
@@ -81,7 +85,7 @@ struct SessionSummary {
   runtime::LoopStats loop;
   std::uint64_t inputs_applied = 0, inputs_refused = 0, inputs_recorded = 0, recorder_dropped = 0;
   std::uint64_t tears = 0, attachments_broken = 0, rolled_back = 0;
-  std::string stop_reason = "duration reached";  // or "SIGTERM", "SIGINT" (SessionConfig::stop)
+  std::string stop_reason = "duration reached";  // or "SIGTERM", "SIGINT" (SessionConfig::stop), "case over" (end_at_case_over)
   std::string recording_problem;                 // empty when the recording is complete
   std::uint64_t telemetry_published = 0, telemetry_dropped = 0;
   std::vector<std::string> receive_lines;  // per subscribed LCM channel: received, refused, handler errors

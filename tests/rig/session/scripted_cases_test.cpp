@@ -79,6 +79,7 @@ Played play(const std::string& case_name, const fs::path& script_file, const std
   config.device_mode = HubMode::lockstep;
   config.unpaced = true;
   config.steps = static_cast<std::uint64_t>(std::llround(out.script.duration_s / config.model.dt_s));
+  config.end_at_case_over = true;  // the score is frozen there; the rest of the script would only follow it
   config.lcm_url = "file://" + (dir / "telemetry.lcmlog").string() + "?mode=w";
   config.command_echo = nullptr;
   int fds[2] = {-1, -1};
