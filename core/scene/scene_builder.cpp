@@ -273,6 +273,24 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
   const double phc = spec.center.azimuth_deg * kDeg;
   const double disc_reach = eye.parameters.optic_disc_radius_mm + 0.6;
 
+  // The membrane's region in fundus coordinates (the epiretinal membrane also covers the disc rim:
+  // see in_region below).
+  const double ring_r = eye.fundus_extent_mm / eye.ora_polar_rad;
+  const auto in_region_q = [&](const Vec2& q) {
+    const double s = q.norm();
+    const double phi = std::atan2(q.y(), q.x());
+    const double dphi = std::abs(std::remainder(phi - phc, 2.0 * kPi));
+    const double circ_len = dphi * ring_r * std::sin(std::max(1e-3, s / ring_r));
+    switch (spec.kind) {
+      case MembraneKind::kEpiretinal: return (q - cf).norm() < spec.size_mm;
+      case MembraneKind::kCircumferential: return std::abs(s - sc) < 0.5 * spec.width_mm && circ_len < 0.5 * spec.size_mm;
+      case MembraneKind::kAnteroposterior:
+        return s > sc && s < std::min(sc + spec.size_mm, eye.fundus_extent_mm - 0.3) && circ_len < 0.5 * spec.width_mm;
+      case MembraneKind::kPerpendicular: return false;
+    }
+    return false;
+  };
+
   SurfaceDescription d;
   d.material = scene.description.materials.membrane;
   d.material.name = spec.name;
@@ -316,23 +334,9 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
       }
     }
   } else {
-    const double ring_r = eye.fundus_extent_mm / eye.ora_polar_rad;
     const auto in_region = [&](const Vec3& p) {
-      const Vec2 q = eye.fundus_coords(p);
-      const double s = q.norm();
-      const double phi = std::atan2(q.y(), q.x());
-      const double dphi = std::abs(std::remainder(phi - phc, 2.0 * kPi));
-      const double circ_len = dphi * ring_r * std::sin(std::max(1e-3, s / ring_r));
-      switch (spec.kind) {
-        case MembraneKind::kEpiretinal:
-          return (q - cf).norm() < spec.size_mm || (p - eye.optic_disc_mm).norm() < disc_reach;
-        case MembraneKind::kCircumferential:
-          return std::abs(s - sc) < 0.5 * spec.width_mm && circ_len < 0.5 * spec.size_mm;
-        case MembraneKind::kAnteroposterior:
-          return s > sc && s < std::min(sc + spec.size_mm, eye.fundus_extent_mm - 0.3) && circ_len < 0.5 * spec.width_mm;
-        case MembraneKind::kPerpendicular: return false;
-      }
-      return false;
+      return in_region_q(eye.fundus_coords(p)) ||
+             (spec.kind == MembraneKind::kEpiretinal && (p - eye.optic_disc_mm).norm() < disc_reach);
     };
     std::vector<std::uint32_t> to_m(retina_mesh.positions.size(), kNone);
     for (const auto& t : retina_mesh.triangles) {
@@ -368,28 +372,82 @@ BuiltMembrane build_membrane(Scene& scene, const TriangleMesh& retina_mesh, cons
     if (fixed[v]) (void)ms.set_fixed(ms.vertex_id(v), true);
   }
 
-  // Instance-vertex attachments.
+  // Instance-vertex attachments. The perpendicular plane is attached at every base vertex, and an
+  // epiretinal membrane at every vertex over the disc rim (strong unless the case makes them all
+  // weak: a membrane is cut off the disc, not peeled off it); each of
+  // those stands for its vertex's share of the tissue (attachment_area_scale). Everywhere else a
+  // membrane is attached at the sites of a square lattice of pitch attachment_spacing_mm in fundus
+  // coordinates, centred on the membrane's centre, each site on the free membrane vertex nearest it:
+  // the number, place, strength and numbering of the attachments — a band's stalks — are then the
+  // same at every mesh resolution, so the pegs a script cuts at 5k are the pegs of the case's 20k,
+  // and each carries the force the case gives (it stands for spacing² of tissue at any mesh).
   out.first_attachment = world.attachment_count();
-  std::uint32_t counter = 0;
-  for (std::uint32_t v = 0; v < from_retina.size(); ++v) {
-    if (from_retina[v] == kNone || fixed[v]) continue;
-    const bool disc = spec.kind == MembraneKind::kEpiretinal && near_disc[v];
-    if (!disc && v % static_cast<std::uint32_t>(spec.attachment_stride) != 0 && spec.kind != MembraneKind::kPerpendicular) continue;
-    if (world.surface(scene.retina).is_fixed(from_retina[v]) && !disc) continue;
-    const bool strong = spec.kind == MembraneKind::kEpiretinal && spec.strength == AttachmentStrength::kMixed ? disc || is_strong(spec, counter)
-                                                                                                               : is_strong(spec, counter);
-    ++counter;
+  const Surface& retina = world.surface(scene.retina);
+  auto attach = [&](std::uint32_t v, bool strong, double scale) {
     AttachmentDescription a;
     a.surface_a = out.surface;
     a.vertex_a = v;
     a.surface_b = scene.retina;
     a.vertex_b = from_retina[v];
-    a.stiffness_un_per_mm = 2e3 * attachment_area_scale(eye);
-    a.break_force_un = (strong ? spec.strong_break_force_un : spec.weak_break_force_un) * attachment_area_scale(eye);
+    a.stiffness_un_per_mm = 2e3 * scale;
+    a.break_force_un = (strong ? spec.strong_break_force_un : spec.weak_break_force_un) * scale;
     a.rest_length_mm = spec.elevation_mm;
     world.add_attachment(a);
     ++out.attachment_count;
     if (strong) ++out.strong_attachments;
+    return world.attachment_count() - 1;
+  };
+  std::vector<std::uint8_t> taken(from_retina.size(), 0);
+  const auto free_vertex = [&](std::uint32_t v) { return from_retina[v] != kNone && !fixed[v] && !retina.is_fixed(from_retina[v]); };
+  if (spec.kind == MembraneKind::kPerpendicular) {
+    for (std::uint32_t v = 0; v < from_retina.size(); ++v) {
+      if (free_vertex(v)) (void)attach(v, is_strong(spec, out.attachment_count), attachment_area_scale(eye));
+    }
+  } else {
+    const auto disc_site = [&](const Vec2& q) {
+      return spec.kind == MembraneKind::kEpiretinal && (q - eye.optic_disc_fundus_mm).norm() < disc_reach;
+    };
+    const auto on_disc_rim = [&](std::uint32_t v) { return spec.kind == MembraneKind::kEpiretinal && near_disc[v] != 0; };
+    // The sites: every lattice point in the membrane's region (the anterior end a band's base holds
+    // and the disc rim excluded), numbered row by row — from the description alone, not the mesh.
+    const double a = spec.attachment_spacing_mm;
+    const int reach = static_cast<int>(std::ceil((spec.size_mm + spec.width_mm + 1.0) / a));
+    const double base_s = eye.fundus_extent_mm - eye.parameters.vitreous_base_mm;
+    std::vector<Vec2> sites;
+    for (int j = -reach; j <= reach; ++j) {
+      for (int i = -reach; i <= reach; ++i) {
+        const Vec2 q = cf + a * Vec2(i, j);
+        if (!in_region_q(q) || disc_site(q)) continue;
+        if (spec.kind == MembraneKind::kAnteroposterior && q.norm() > base_s) continue;
+        sites.push_back(q);
+      }
+    }
+    std::vector<Vec2> where(from_retina.size());
+    for (std::uint32_t v = 0; v < from_retina.size(); ++v) {
+      if (from_retina[v] != kNone) where[v] = eye.fundus_coords(retina_mesh.positions[from_retina[v]]);
+    }
+    out.sites.assign(sites.size(), kNone);
+    for (std::size_t k = 0; k < sites.size(); ++k) {
+      // The nearest free vertex not already holding a site, within the site's cell and a bit.
+      std::uint32_t best = kNone;
+      double best_d = 0.75 * a;
+      for (std::uint32_t v = 0; v < from_retina.size(); ++v) {
+        if (taken[v] || !free_vertex(v) || on_disc_rim(v)) continue;
+        const double dist = (where[v] - sites[k]).norm();
+        if (dist < best_d) best_d = dist, best = v;
+      }
+      if (best == kNone) continue;  // no vertex of this mesh near the site (a coarse mesh's edge)
+      taken[best] = 1;
+      const bool strong = is_strong(spec, static_cast<std::uint32_t>(k));
+      out.sites[k] = attach(best, strong, 1.0);
+    }
+    if (spec.kind == MembraneKind::kEpiretinal) {
+      for (std::uint32_t v = 0; v < from_retina.size(); ++v) {
+        if (from_retina[v] != kNone && !fixed[v] && on_disc_rim(v)) {
+          (void)attach(v, spec.strength != AttachmentStrength::kWeak, attachment_area_scale(eye));
+        }
+      }
+    }
   }
   if (out.attachment_count == 0) throw InvalidArgument(what + ": no attachment to the retina (raise its size)");
 

@@ -31,6 +31,10 @@ struct BuiltMembrane {
   std::uint32_t first_attachment = 0;
   std::uint32_t attachment_count = 0;
   std::uint32_t strong_attachments = 0;
+  // Per site of the attachment lattice (MembraneSpec::attachment_spacing_mm), in the order the
+  // builder numbers them from the description alone: the site's attachment, or kNone where no vertex
+  // of this mesh lies near it. Empty for the perpendicular plane (attached at every base vertex).
+  std::vector<std::uint32_t> sites;
   std::uint32_t detachment_force = kNone;  // with detach_radius_mm > 0
 };
 

@@ -157,7 +157,7 @@ void SceneDescription::validate() const {
     require_range(m.height_mm, 0.3, 8.0, w + "height_mm");
     require_range(m.rest_length_scale, 0.2, 2.0, w + "rest_length_scale");
     require_range(m.strong_fraction, 0.0, 1.0, w + "strong_fraction");
-    if (m.attachment_stride < 1 || m.attachment_stride > 50) throw InvalidArgument(w + "attachment_stride must be in [1, 50]");
+    require_range(m.attachment_spacing_mm, 0.2, 5.0, w + "attachment_spacing_mm");
     if (std::isnan(m.weak_break_force_un) || !(m.weak_break_force_un > 0.0)) throw InvalidArgument(w + "weak_break_force_un must be > 0");
     if (std::isnan(m.strong_break_force_un) || !(m.strong_break_force_un > 0.0)) throw InvalidArgument(w + "strong_break_force_un must be > 0");
     require_range(m.detach_radius_mm, 0.0, 15.0, w + "detach_radius_mm");

@@ -67,7 +67,11 @@ struct MembraneSpec {
                                    // perpendicular plane along its height
   AttachmentStrength strength = AttachmentStrength::kMixed;
   double strong_fraction = 0.25;   // kMixed: share of strong attachments (epiretinal: those at the disc are strong)
-  int attachment_stride = 3;
+  // Attachments stand at the sites of a square lattice of this pitch in fundus coordinates (mm),
+  // each on the membrane vertex nearest it: the same number and places at every mesh resolution
+  // (the perpendicular plane: every base vertex; an epiretinal membrane: also every vertex over the
+  // disc rim).
+  double attachment_spacing_mm = 0.7;
   double weak_break_force_un = 40.0;
   double strong_break_force_un = std::numeric_limits<double>::infinity();
   // Tractional detachment: within this distance (mm) of the membrane, subretinal fluid carries most

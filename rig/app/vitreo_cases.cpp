@@ -3,6 +3,7 @@
 //   vitreo-cases list [--dir scenes]
 //   vitreo-cases validate scenes/*.toml
 //   vitreo-cases inspect my_case.toml [--no-settle] [--snapshot start.snap]
+//   vitreo-cases sites my_case.toml MEMBRANE [--retina-vertices N] [--height-mm H]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -148,7 +149,8 @@ int cmd_inspect(const std::string& file, bool settle, const std::string& snapsho
   }
   std::printf("attachments %u (gel adhesions %u)\n", s.world.attachment_count(), s.gel_attachments);
   for (const auto& m : s.membranes) {
-    std::printf("membrane %-16s %u attachments, %u strong\n", m.name.c_str(), m.attachment_count, m.strong_attachments);
+    std::printf("membrane %-16s %u attachments, %u strong, %zu lattice sites\n", m.name.c_str(), m.attachment_count, m.strong_attachments,
+                m.sites.size());
   }
   for (const auto& t : s.tears) std::printf("tear %-20s %u vertices cut, flap of %zu vertices\n", t.name.c_str(), t.cut_vertices, t.flap_vertices.size());
   for (std::size_t i = 0; i < s.detachment_forces.size(); ++i) {
@@ -191,6 +193,19 @@ int cmd_inspect(const std::string& file, bool settle, const std::string& snapsho
   return 0;
 }
 
+// A membrane's attachment sites in the settled start, for whoever writes a script that cuts its stalks
+// (tools/delamination_script.py reads this table).
+int cmd_sites(const std::string& file, const std::string& membrane, int retina_vertices, double height_mm) {
+  scene_io::CaseLoadOptions o;
+  o.textures = false;
+  o.retina_vertices = retina_vertices;
+  const auto c = rig::prepare_case({scene_io::read_case_text(file)}, 0, o);
+  std::printf("# %s at %d retina vertices, the working hand through %s\n", c->scene->description.name.c_str(),
+              c->scene->description.anatomy.retina_vertices, c->tracker_port_names[rig::kToolTracker].c_str());
+  std::fputs(rig::describe_membrane_sites(*c, membrane, height_mm).c_str(), stdout);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -214,6 +229,15 @@ int main(int argc, char** argv) {
   inspect->add_flag("--no-settle", no_settle, "skip settling");
   inspect->add_option("--snapshot", snapshot, "write the settled state to this snapshot file");
 
+  std::string membrane;
+  int retina_vertices = 0;
+  double height_mm = 0.55;
+  auto* sites = app.add_subcommand("sites", "print a membrane's attachment sites in the settled start (where each strand crosses a height above the wall), for script writers");
+  sites->add_option("file", file, "scene file")->required();
+  sites->add_option("membrane", membrane, "membrane name")->required();
+  sites->add_option("--retina-vertices", retina_vertices, "load at this retina resolution (default: the case's own)");
+  sites->add_option("--height-mm", height_mm, "the height above the wall at which to report each strand (default 0.55)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -225,6 +249,7 @@ int main(int argc, char** argv) {
     if (*list) return cmd_list(dir.empty() ? vitreo::files::default_scenes_dir() : dir);
     if (*validate) return cmd_validate(files);
     if (*inspect) return cmd_inspect(file, !no_settle, snapshot);
+    if (*sites) return cmd_sites(file, membrane, retina_vertices, height_mm);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -16,7 +16,7 @@ namespace {
 // Bump when the builder changes what a description builds into (or settles into: 2, the solver's
 // tears clean up after themselves, core/topology/clean_topology.hpp; 3, the perpendicular traction
 // plane contracts along its height only; 4, attachments scale with the area they stand for).
-constexpr int kBuilderVersion = 4;
+constexpr int kBuilderVersion = 5;
 
 
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 0xcbf29ce484222325ULL) {

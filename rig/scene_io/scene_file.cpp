@@ -442,7 +442,7 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     t.number("rest_length_scale", s.rest_length_scale);
     s.strength = strength(t);
     t.number("strong_fraction", s.strong_fraction);
-    t.integer("attachment_stride", s.attachment_stride, 1, 50);
+    t.number("attachment_spacing_mm", s.attachment_spacing_mm);
     t.number("weak_break_force_un", s.weak_break_force_un);
     t.number("strong_break_force_un", s.strong_break_force_un);
     t.number("detach_radius_mm", s.detach_radius_mm);

@@ -274,6 +274,13 @@ Vec3 centroid(const std::vector<Vec3>& pts) {
   return pts.empty() ? c : Vec3(c / static_cast<double>(pts.size()));
 }
 
+// The point of the globe wall on the ray from its centre through p, and the inward normal there.
+Landmark wall_under(const core::Scene& scene, const Vec3& p) {
+  const Vec3 centre = scene.eye.wall.center();
+  const Vec3 dir = (p - centre).normalized();
+  return Landmark{centre + dir * scene.eye.wall.radius_toward(dir), -dir};
+}
+
 class LandmarkResolver {
  public:
   LandmarkResolver(const PreparedCase& c, const SurgicalScript& s) : c_(c), s_(s) {}
@@ -319,12 +326,13 @@ class LandmarkResolver {
           }
           return on_fundus(best);
         };
+        if (part.rfind("site.", 0) == 0) return site(m, part.substr(5), line, key);
         if (part.empty() || part == "centre") return on_fundus(c);
         if (part == "edge") return extreme(tangent_to(port.position_mm), 1.0);
         if (part == "mid") return extreme(tangent_to(port.position_mm), 0.5);
         if (part == "far_edge") return extreme(-tangent_to(port.position_mm), 1.0);
         if (part == "disc_edge") return extreme(tangent_to(scene.eye.optic_disc_mm), 1.0);
-        fail(line, key, "membrane." + item + "." + part + ": no such part (centre, edge, mid, far_edge, disc_edge)");
+        fail(line, key, "membrane." + item + "." + part + ": no such part (centre, edge, mid, far_edge, disc_edge, site.N)");
       }
       fail(line, key, "the case has no membrane '" + item + "'");
     }
@@ -373,6 +381,22 @@ class LandmarkResolver {
 
   [[noreturn]] void fail(int line, const std::string& key, const std::string& why) const {
     throw std::runtime_error(s_.file + ":" + std::to_string(line) + ": " + key + ": " + why);
+  }
+
+  // membrane.NAME.site.N: the globe wall under the retina end of the attachment at the membrane's
+  // lattice site N (scene_builder.cpp numbers the sites from the case alone, so N is the same stalk
+  // at every resolution); inward toward the centre.
+  Landmark site(const core::BuiltMembrane& m, const std::string& index, int line, const std::string& key) const {
+    const core::Scene& scene = *c_.scene;
+    char* end = nullptr;
+    const long n = std::strtol(index.c_str(), &end, 10);
+    const std::string name = "membrane." + m.name + ".site." + index;
+    if (index.empty() || !end || *end != '\0' || n < 0 || n >= static_cast<long>(m.sites.size())) {
+      fail(line, key, name + ": no such site (0.." + std::to_string(static_cast<long>(m.sites.size()) - 1) + ")");
+    }
+    const std::uint32_t a = m.sites[static_cast<std::size_t>(n)];
+    if (a == core::kNone) fail(line, key, name + ": no vertex of this resolution's mesh stands at that site");
+    return wall_under(scene, scene.world.surface(scene.retina).position(scene.world.attachment_vertex_b(a)));
   }
 
  private:
@@ -714,6 +738,79 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     if (f.kind == "jump") std::snprintf(buf, sizeof buf, "fault %.1f %.1f jump %g\n", f.at_s * 1e3, f.duration_s * 1e3, f.value);
     else std::snprintf(buf, sizeof buf, "fault %.1f %.1f %s\n", f.at_s * 1e3, f.duration_s * 1e3, f.kind.c_str());
     it->second += buf;
+  }
+  return out;
+}
+
+}  // namespace vitreo::rig
+
+namespace vitreo::rig {
+
+namespace {
+
+// Height of p above the globe wall (negative: beyond it).
+double height_above_wall(const core::Scene& scene, const Vec3& p) {
+  const Vec3 d = p - scene.eye.wall.center();
+  return scene.eye.wall.radius_toward(d.normalized()) - d.norm();
+}
+
+// Where p lies in the frame a waypoint's toward_port_mm / across_mm step in from landmark l (the
+// inverse of resolve_script's step: the ray from the globe centre through p met with l's tangent plane).
+std::pair<double, double> toward_across(const core::Scene& scene, const Landmark& l, const Vec3& port, const Vec3& p) {
+  Vec3 toward = port - l.at;
+  toward -= toward.dot(l.inward) * l.inward;
+  toward.normalize();
+  const Vec3 across = l.inward.cross(toward);
+  const Vec3 c = scene.eye.wall.center();
+  const Vec3 ray = (p - c).normalized();
+  const double s = (l.at - c).dot(l.inward) / ray.dot(l.inward);
+  const Vec3 on_plane = c + s * ray - l.at;
+  return {on_plane.dot(toward), on_plane.dot(across)};
+}
+
+}  // namespace
+
+std::string describe_membrane_sites(const PreparedCase& c, const std::string& membrane, double height_mm) {
+  const core::Scene& scene = *c.scene;
+  const core::BuiltMembrane* m = nullptr;
+  for (const auto& b : scene.membranes)
+    if (b.name == membrane) m = &b;
+  if (!m) throw std::runtime_error("the case has no membrane '" + membrane + "'");
+  const Vec3 port = c.tracker_ports[kToolTracker].position_mm;
+  const core::Surface& retina = scene.world.surface(scene.retina);
+  const core::Surface& band = scene.world.surface(m->surface);
+  const Vec3 centre = centroid(alive_positions(scene.world, m->surface));
+  const Landmark mid{centre, (scene.eye.wall.center() - centre).normalized()};
+  char line[256];
+  std::string out;
+  std::snprintf(line, sizeof line, "# membrane %s: %zu sites, %u attachments; its centre %.4f mm above the wall; strands crossing %.3f mm above it\n",
+                membrane.c_str(), m->sites.size(), m->attachment_count, height_above_wall(scene, centre), height_mm);
+  out += line;
+  out += "# site attachment state strength | from the site: toward_port_mm across_mm | from the centre: toward_port_mm across_mm | foot: height, x y z (eye frame, mm)\n";
+  for (std::size_t n = 0; n < m->sites.size(); ++n) {
+    const std::uint32_t a = m->sites[n];
+    if (a == core::kNone) {
+      std::snprintf(line, sizeof line, "site %zu none\n", n);
+      out += line;
+      continue;
+    }
+    const Vec3 foot = retina.position(scene.world.attachment_vertex_b(a));
+    const Vec3 top = band.position(scene.world.attachment_vertex_a(a));
+    // The strand's point at height_mm above the wall (bisection: the height grows from foot to top).
+    double lo = 0.0, hi = 1.0;
+    if (height_above_wall(scene, foot) >= height_mm) hi = 0.0;
+    for (int i = 0; i < 60 && hi > 0.0; ++i) {
+      const double s = 0.5 * (lo + hi);
+      (height_above_wall(scene, foot + s * (top - foot)) < height_mm ? lo : hi) = s;
+    }
+    const Vec3 cross = foot + hi * (top - foot);
+    const auto [ts, as] = toward_across(scene, wall_under(scene, foot), port, cross);
+    const auto [tc, ac] = toward_across(scene, mid, port, cross);
+    const bool strong = scene.world.attachment_break_force(a) == std::numeric_limits<double>::infinity();
+    std::snprintf(line, sizeof line, "site %zu %u %s %s %.4f %.4f %.4f %.4f %.4f %.4f %.4f %.4f\n", n, a,
+                  scene.world.attachment_holds(a) ? "holds" : "gone", strong ? "strong" : "weak", ts, as, tc, ac, height_above_wall(scene, foot),
+                  foot.x(), foot.y(), foot.z());
+    out += line;
   }
   return out;
 }

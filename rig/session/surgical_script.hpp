@@ -119,11 +119,19 @@ struct ResolvedScript {
 // Resolves the landmarks against the case as loaded; throws std::runtime_error "FILE:LINE: KEY: why"
 // for a landmark, a tool or a light pipe the case lacks, and for an unreachable waypoint.
 // Landmarks: port (the hand's own), fovea, disc, roi (the case's region of interest),
-// membrane.NAME[.centre|.edge|.mid|.far_edge|.disc_edge], tear.NAME[.flap|.hinge],
+// membrane.NAME[.centre|.edge|.mid|.far_edge|.disc_edge|.site.N] (site.N: the wall under the retina
+// end of the attachment at lattice site N), tear.NAME[.flap|.hinge],
 // detachment.NAME, guide.NAME[.start|.end|.N] (N: the guide's N-th point).
 // `microscope`: the settings the session's microscope runs with (its pan speed times look_at's joystick).
 ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& c, const PedalMapping& pedals,
                               const core::MicroscopeSettings& microscope = {});
+
+// For script writers (`vitreo-cases sites`): a membrane's attachment sites in the case as loaded,
+// one line each — its attachment, whether it holds, weak or strong, and where its strand crosses
+// height_mm above the globe wall, as toward_port_mm / across_mm for the working hand's port from the
+// site's own landmark (membrane.NAME.site.N) and from the membrane's centre, with the height of the
+// strand's foot and its position (eye frame). Throws std::runtime_error for a membrane the case lacks.
+std::string describe_membrane_sites(const PreparedCase& c, const std::string& membrane, double height_mm);
 
 // The simulated microscope pedal's device name, and whether a script works the microscope (then
 // the scripted rig has that pedal too).
