@@ -142,9 +142,15 @@ bool SimulationModel::apply_tracker(const telemetry::TrackerSample& t) {
   InstrumentSlot& slot = instruments_[t.instrument_id];
   if (slot.frozen) return true;  // a frozen instrument ignores its (late) samples
   InstrumentPose pose;
-  // In the fixture frame: the instrument system applies the eye's rotation itself.
+  // In the fixture frame: the instrument system applies the eye's rotation itself. The port is where
+  // the turned eye carries it (the ports are known with the eye at rest), so the shaft's axis runs
+  // through the cannula the instrument is in.
   const std::size_t i = t.instrument_id;
-  const Port& port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[i];
+  Port port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[i];
+  if (eye_tracked_) {
+    port.position_mm = eye_rotation_ * port.position_mm;
+    port.outward = eye_rotation_ * port.outward;
+  }
   if (!map_through_port(tracked_pose(t), port, core::Quat::Identity(), config_.calibration[i], pose)) return false;
   slot.present = true;
   slot.port = case_->tracker_port_ids[i];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
@@ -201,6 +207,10 @@ core::StepReport SimulationModel::step() {
         // Untracked light pipe: held 6 mm into its port, aimed at the case's region of interest.
         const core::Vec3 port = case_->tracker_ports[kLightPipeTracker].position_mm;
         in = core::InstrumentInput::through_port(port, (case_->focus_mm - port).normalized(), 6.0);
+        if (eye_tracked_) {  // held in the eye's port, it turns with the eye
+          in.tip_fixture_mm = eye_rotation_ * in.tip_fixture_mm;
+          in.axis_fixture = eye_rotation_ * in.axis_fixture;
+        }
       }
     } else if (static_cast<int>(i) == tool && instruments_[kToolTracker].present) {
       in = tracked(instruments_[kToolTracker]);

@@ -242,7 +242,34 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
       s.faults.push_back(f);
     }
   }
-  top.refuse_unknown("script, hand, fault");
+  if (const toml::node* eye = top.get("eye")) {
+    const toml::array* a = eye->as_array();
+    if (!a || !a->is_array_of_tables()) top.fail(*eye, "eye", "must be [[eye]] tables");
+    if (s.kind == "calibration") top.fail(*eye, "eye", "a technician's script turns the eye with tilt_deg on a waypoint");
+    double free_at = 0.0;  // when the last turn ends
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::table& t = *a->get(i)->as_table();
+      Reader r(t, origin, "eye[" + std::to_string(i) + "].");
+      ScriptEyeTurn e;
+      e.line = line_of(t);
+      const auto at = r.number("at_s", 0, 3600);
+      if (!at) r.fail_here("at_s", "missing");
+      if (*at < free_at) {
+        char why[96];
+        std::snprintf(why, sizeof why, "the eye is still turning then (the turn before ends at %.3f s)", free_at);
+        r.fail(*r.get("at_s"), "at_s", why);
+      }
+      e.at_s = *at;
+      e.duration_s = r.number("duration_s", 0.05, 600).value_or(e.duration_s);
+      // The fixture turns about ±25° either way (PROTOCOL.md's eyeball fixture).
+      e.yaw_deg = r.number("yaw_deg", -25, 25).value_or(0);
+      e.pitch_deg = r.number("pitch_deg", -25, 25).value_or(0);
+      r.refuse_unknown("at_s, duration_s, yaw_deg, pitch_deg");
+      free_at = e.at_s + e.duration_s;
+      s.eye.push_back(e);
+    }
+  }
+  top.refuse_unknown("script, hand, fault, eye");
   return s;
 }
 
@@ -434,6 +461,50 @@ std::string tracker_key(double t_ms, const Vec3& p, double jaws, const Vec3& eul
   return buf;
 }
 
+// The eye as the script turns it: the fixture's yaw and pitch at time t (linear through each turn),
+// and a hand's key as its tracker reads it with the eye so turned — the instruments sit in the eye's
+// ports, so the tip and the handle turn with it about the globe centre (the eye frame's origin),
+// as core/instruments/stage_place.cpp turns them back.
+class EyeTurns {
+ public:
+  explicit EyeTurns(const std::vector<ScriptEyeTurn>& turns) : turns_(turns) {}
+  bool any() const { return !turns_.empty(); }
+  double last_end_s() const { return turns_.empty() ? 0.0 : turns_.back().at_s + turns_.back().duration_s; }
+  bool turning_during(double t0, double t1) const {
+    for (const auto& e : turns_)
+      if (e.at_s < t1 && e.at_s + e.duration_s > t0) return true;
+    return false;
+  }
+  // (yaw, pitch) in degrees at t.
+  std::pair<double, double> angles_at(double t) const {
+    double yaw = 0.0, pitch = 0.0;
+    for (const auto& e : turns_) {
+      if (t <= e.at_s) break;
+      const double f = std::min(1.0, (t - e.at_s) / e.duration_s);
+      yaw += f * (e.yaw_deg - yaw);
+      pitch += f * (e.pitch_deg - pitch);
+    }
+    return {yaw, pitch};
+  }
+  // The fixture's orientation for those angles, as the eyeball emulator encodes them (Z then Y).
+  static core::Quat rotation(double yaw_deg, double pitch_deg) {
+    return core::Quat(Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch_deg * kDeg, Vec3::UnitY()));
+  }
+  std::string key(double t_s, const Vec3& p, double jaws, const Vec3& euler_deg) const {
+    if (turns_.empty()) return tracker_key(t_s * 1e3, p, jaws, euler_deg);
+    const auto [yaw, pitch] = angles_at(t_s);
+    const core::Quat r = rotation(yaw, pitch);
+    const core::Quat hand = Eigen::AngleAxisd(euler_deg.x() * kDeg, Vec3::UnitZ()) * Eigen::AngleAxisd(euler_deg.y() * kDeg, Vec3::UnitY()) *
+                            Eigen::AngleAxisd(euler_deg.z() * kDeg, Vec3::UnitX());
+    const Eigen::Matrix3d m = (r * hand).toRotationMatrix();
+    const Vec3 euler(std::atan2(m(1, 0), m(0, 0)), std::asin(std::clamp(-m(2, 0), -1.0, 1.0)), std::atan2(m(2, 1), m(2, 2)));
+    return tracker_key(t_s * 1e3, r * p, jaws, euler / kDeg);
+  }
+
+ private:
+  const std::vector<ScriptEyeTurn>& turns_;
+};
+
 // A change of the microscope pedal a waypoint asks for, from its start on.
 struct MicroscopeChange {
   double t_s;
@@ -557,6 +628,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
   if (!scene.description.name.empty() && script.case_name != scene.description.name)
     throw std::runtime_error(script.file + ": script.case: written for '" + script.case_name + "', not for '" + scene.description.name + "'");
   LandmarkResolver landmarks(c, script);
+  const EyeTurns eye(script.eye);
   ResolvedScript out;
   out.duration_s = script.duration_s;
   // The working hand's tools in the order the instrument switch cycles through them.
@@ -589,18 +661,20 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     double jaws = 0.0, t = 0.0;
     std::optional<double> roll;  // unset: the tracker's neutral orientation
     int tool = 0;
-    std::string keys = tracker_key(0, pos, 0);
+    std::string keys = eye.key(0, pos, 0, Vec3::Zero());
     auto orientation = [&](const Vec3& p, std::optional<double> r) { return r ? euler_for_roll(port.position_mm, p, *r) : Vec3::Zero(); };
     auto add_segment = [&](const Vec3& to, double to_jaws, double duration, std::optional<double> to_roll) {
       // Tremor: seeded offsets at 20 Hz along the way (none while the hand is outside the eye).
-      const int n = script.tremor_mm > 0.0 ? std::max(1, static_cast<int>(duration * 20.0)) : 1;
+      // While the eye turns, keys at 20 Hz too: the tracker sees the tip turn with the eye.
+      const bool sampled = script.tremor_mm > 0.0 || eye.turning_during(t, t + duration);
+      const int n = sampled ? std::max(1, static_cast<int>(duration * 20.0)) : 1;
       const std::optional<double> from_roll = roll ? roll : (to_roll ? std::optional<double>(0.0) : std::nullopt);
       for (int i = 1; i <= n; ++i) {
         const double f = static_cast<double>(i) / n;
         Vec3 p = pos + f * (to - pos);
         if (script.tremor_mm > 0.0 && i < n) p += script.tremor_mm * Vec3(tremor(rng), tremor(rng), tremor(rng));
         const std::optional<double> r = to_roll ? std::optional<double>(*from_roll + f * (*to_roll - *from_roll)) : from_roll;
-        keys += tracker_key((t + f * duration) * 1e3, p, jaws + f * (to_jaws - jaws), orientation(p, r));
+        keys += eye.key(t + f * duration, p, jaws + f * (to_jaws - jaws), orientation(p, r));
       }
       out.path_mm[hand.tracker] += (to - pos).norm();
       t += duration;
@@ -667,6 +741,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
       add_segment(target, w.jaws.value_or(jaws), std::max(duration, 0.001), w.roll_deg);
       if (w.hold_s > 0.0) add_segment(pos, jaws, w.hold_s / script.speed_scale, std::nullopt);
     }
+    // A hand done before the eye stops turning stays where it is in the eye, turning with it.
+    if (eye.any() && t < eye.last_end_s()) add_segment(pos, jaws, eye.last_end_s() - t, std::nullopt);
     const std::string name = "tracker-" + std::to_string(hand.tracker);
     // The working hand holds a universal handpiece (tool type 0): the script's `tool =` picks the
     // tool with instrument-switch presses. The other hand's handpiece is the light pipe.
@@ -680,7 +756,7 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
   if (!out.device_scripts.count("tracker-0")) {  // no working hand scripted: it stays outside the eye
     const Port& port = c.tracker_ports[kToolTracker];
     out.device_scripts["tracker-0"] = "device tracker\nrate_hz 1000\nserial 1001\ntool 0\ninstrument 0\nloop 0\nseed " +
-                                      std::to_string(script.seed) + "\n" + tracker_key(0, port.position_mm + 2.0 * port.outward, 0);
+                                      std::to_string(script.seed) + "\n" + eye.key(0, port.position_mm + 2.0 * port.outward, 0, Vec3::Zero());
   }
 
   // The pedals: changes in time order, each a step (two keys 1 ms apart); a switch press is 50 ms
@@ -727,8 +803,25 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
   pedal_key(std::max(last_ms + 1.0, script.duration_s * 1e3), st);
   out.device_scripts["pedals"] = "device pedals\nrate_hz 500\nserial 2001\nloop 0\nseed " + std::to_string(script.seed + 10) + "\n" + pkeys;
   if (!microscope_changes.empty()) out.device_scripts[kMicroscopePedalDevice] = microscope_pedal_script(microscope_changes, c, pedals, microscope, script);
-  out.device_scripts["eyeball"] = "device eyeball\nrate_hz 250\nserial 3001\nloop 0\nseed " + std::to_string(script.seed + 20) +
-                                  "\nkey 0 0 0 0 0 0\nkey " + std::to_string(static_cast<long>(script.duration_s * 1e3) + 1) + " 0 0 0 0 0\n";
+  // The eyeball fixture: at rest, or turned as the script's [[eye]] turns say (a key where each turn
+  // starts and ends; the emulator interpolates between them). No port depths: the trackers carry
+  // the instruments.
+  std::string ekeys = "key 0 0 0 0 0 0\n";
+  for (const ScriptEyeTurn& e : script.eye) {
+    char buf[128];
+    const auto [yaw0, pitch0] = eye.angles_at(e.at_s);
+    std::snprintf(buf, sizeof buf, "key %.1f %.4f %.4f 0 0 0\nkey %.1f %.4f %.4f 0 0 0\n", e.at_s * 1e3, yaw0, pitch0,
+                  (e.at_s + e.duration_s) * 1e3, e.yaw_deg, e.pitch_deg);
+    ekeys += buf;
+  }
+  const auto [yaw_end, pitch_end] = eye.angles_at(script.duration_s);
+  char last[96];
+  std::snprintf(last, sizeof last, "key %ld %.4f %.4f 0 0 0\n", static_cast<long>(std::max(script.duration_s, eye.last_end_s()) * 1e3) + 1,
+                yaw_end, pitch_end);
+  out.device_scripts["eyeball"] = "device eyeball\nrate_hz 250\nserial 3001\nloop 0\nseed " + std::to_string(script.seed + 20) + "\n" +
+                                  (script.eye.empty() ? std::string("key 0 0 0 0 0 0\nkey ") + std::to_string(static_cast<long>(script.duration_s * 1e3) + 1) +
+                                                            " 0 0 0 0 0\n"
+                                                      : ekeys + last);
   for (const ScriptFault& f : script.faults) {
     auto it = out.device_scripts.find(f.device);
     if (it == out.device_scripts.end())

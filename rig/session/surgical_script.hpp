@@ -87,6 +87,15 @@ struct ScriptFault {
   double value = 0.0;  // jump: milliseconds
 };
 
+// The surgeon turning the eye with the instruments in its ports, as the eyeball fixture reads it: from
+// at_s on, over duration_s, to yaw_deg (about the eye's z axis, anterior) and pitch_deg (about its
+// y axis) from the rest reading 0, 0 — the fixture's own angles (drivers/sim/emulator.hpp).
+struct ScriptEyeTurn {
+  int line = 0;
+  double at_s = 0.0, duration_s = 0.5;
+  double yaw_deg = 0.0, pitch_deg = 0.0;
+};
+
 struct SurgicalScript {
   std::string file;        // where it was read from
   std::string case_name;   // the case it is written for
@@ -101,6 +110,7 @@ struct SurgicalScript {
   double press_mm = 0.0;
   std::vector<ScriptHand> hands;
   std::vector<ScriptFault> faults;
+  std::vector<ScriptEyeTurn> eye;  // in time order; none: the eye stays at rest
 };
 
 // Parses a script; throws std::runtime_error "FILE:LINE: KEY: why" on malformed input.
