@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """delamination_script.py SITES CASE MEMBRANE OUT [--kind K] [--tip-h MM] [--roll DEG] [--slope-deg DEG]
-                          [--speed MM_S] [--tremor MM --seed N] [--summary TEXT] [--comment FILE]
+                          [--speed MM_S] [--tremor MM --seed N] [--side MM] [--deeper MM]
+                          [--order along|back|far-first] [--passes 1|2] [--summary TEXT] [--comment FILE]
 
 Writes a surgical script (scenes/scripts/README.md) that delaminates an elevated band with horizontal
 scissors: for each stalk, the jaws are opened 1.4 mm back along the shaft, slid in along it until the
@@ -16,10 +17,19 @@ so the script follows the stalks wherever a mesh puts them: the sites are fixed 
 the case (attachment_spacing_mm), the same at 5k and at the case's own resolution. The table from
 either resolution gives nearly the same script; the shipped ones are written from the 5k table.
 
-The stalks are cut in order along the band (its long axis in the centre's frame); roll is the roll
+The stalks are cut in order along the band (its long axis in the centre's frame), or the row farther
+from the port first (--order far-first: the circumferential band's experts, whose far stalks' strands
+move once their near neighbours are cut), and --passes 2 goes back over them all; roll is the roll
 that turns the jaws into the plane most nearly parallel to the retina (the vitrector's port-inward
 roll less 90°), slope_deg the shaft's angle to the fundus there (it sets how far the hinge stands
 back from the closed tip).
+
+The shipped scripts, from `vitreo-cases sites scenes/CASE.toml BAND --retina-vertices 5000`:
+  traction_anteroposterior (ap_band) expert: --roll 15.7
+                                     clumsy: --roll 15.7 --tip-h 0.12 --speed 3 --tremor 0.02 --seed 3
+  traction_circumferential (band)    expert: --roll 26.2 --order far-first --passes 2
+                                     clumsy: the expert's, with --tip-h 0.12 --speed 3 --tremor 0.02 --seed 3
+each with --kind, --summary and the file's own comment block (--comment).
 
 Why this shape: the jaws (1 mm, 25° half-opening) cut a stalk only where they sweep across it while
 closing (core/instruments/topology_adapter.cpp); a stalk's strand moves once its neighbours are cut,
@@ -40,6 +50,7 @@ p.add_argument('--seed', type=int, default=1)
 p.add_argument('--summary', default='')
 p.add_argument('--side', type=float, default=0.1, help='each stalk: closes this far to either side of it (mm)')
 p.add_argument('--deeper', type=float, default=0.15, help='then one this far deeper, away from the port (mm)')
+p.add_argument('--order', default='along', choices=['along', 'back', 'far-first'], help='along the band, back along it, or the far row (away from the port) first')
 p.add_argument('--passes', type=int, default=1, help='2: then back along the band again, for stalks a close missed')
 p.add_argument('--comment', help='a file whose text heads the script (its comment block)')
 a = p.parse_args()
@@ -56,7 +67,13 @@ mt = sum(s[3] for s in stalks) / n; ma = sum(s[4] for s in stalks) / n
 stt = sum((s[3] - mt) ** 2 for s in stalks); saa = sum((s[4] - ma) ** 2 for s in stalks)
 sta = sum((s[3] - mt) * (s[4] - ma) for s in stalks)
 ang = 0.5 * math.atan2(2 * sta, stt - saa)
-order = sorted(stalks, key=lambda s: (s[3] - mt) * math.cos(ang) + (s[4] - ma) * math.sin(ang))
+along = lambda s: (s[3] - mt) * math.cos(ang) + (s[4] - ma) * math.sin(ang)
+order = sorted(stalks, key=along)
+if a.order == 'back':
+    order = order[::-1]
+elif a.order == 'far-first':  # toward_port_mm from the centre: the far row has the smaller values
+    mid = sorted(s[3] for s in stalks)[n // 2]
+    order = sorted((s for s in stalks if s[3] < mid), key=along) + sorted((s for s in stalks if s[3] >= mid), key=along)
 
 back = 0.5 * math.cos(math.radians(a.slope_deg))  # the closed tip stands this far past the stalk, away from the port
 stand = 1.4
