@@ -199,9 +199,10 @@ TEST(TelemetryContract, InstrumentStateIsInTheEyeFrameWithTheShaftTowardTheHandl
     EXPECT_LT((tip - tip_eye).norm(), 1e-6) << "eye frame: " << tip.transpose() << " expected " << tip_eye.transpose();
     if (s.port_id >= 0) {
       ++inserted;
-      // Through the port: in the fixture frame the shaft runs from the port to the tip, so from the
-      // tip toward the handle it points at the port — turned into the eye frame.
-      const core::Vec3 to_handle = q.conjugate() * (port - tip_fixture).normalized();
+      // Through the port: the shaft runs from the eye's port, where the turned eye carries it
+      // (q · port in the fixture frame), to the tip — so in the eye frame, from the tip toward the
+      // handle it points at the eye's own port.
+      const core::Vec3 to_handle = q.conjugate() * (q * port - tip_fixture).normalized();
       const core::Vec3 axis(s.shaft_axis[0], s.shaft_axis[1], s.shaft_axis[2]);
       EXPECT_LT((axis - to_handle).norm(), 1e-6) << "tip to handle: " << axis.transpose() << " expected " << to_handle.transpose();
       // The insertion: from the port to the tip along the shaft, with the eye's port where it is.
