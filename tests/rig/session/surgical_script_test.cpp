@@ -102,6 +102,13 @@ TEST_F(Resolving, WhatTheCaseLacksOrNoInstrumentReachesIsRefusedAtLoad) {
   const std::string other = "[script]\nversion = 1\ncase = \"low_membrane_macula\"\n";
   EXPECT_NE(resolve_error(other).find("not for 'exercise_pull_tissue'"), std::string::npos) << resolve_error(other);
   EXPECT_EQ(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.patch.mid\"\nabove_mm = 1.0\n"), "");
+  // A membrane's attachment sites: numbered from the case, so site 999 is refused with the range.
+  const std::string site = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.patch.site.999\"\nabove_mm = 1.0\n";
+  EXPECT_NE(resolve_error(site).find("r.toml:7: hand[0].waypoint[0].to: membrane.patch.site.999: no such site (0.."), std::string::npos)
+      << resolve_error(site);
+  const std::string bad_site = std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.patch.site.x\"\nabove_mm = 1.0\n";
+  EXPECT_NE(resolve_error(bad_site).find("membrane.patch.site.x: no such site"), std::string::npos) << resolve_error(bad_site);
+  EXPECT_EQ(resolve_error(std::string(kHead) + "[[hand]]\n[[hand.waypoint]]\nto = \"membrane.patch.site.0\"\nabove_mm = 1.0\n"), "");
 }
 
 TEST_F(Resolving, AStandoffPutsTheTipOnThePortLineShortOfItsPoint) {
