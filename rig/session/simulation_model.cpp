@@ -137,29 +137,24 @@ bool SimulationModel::apply_link(std::int32_t channel, const telemetry::LinkChan
   return true;
 }
 
-// In the fixture frame (the instrument system applies the eye's rotation itself), through the port
-// where the turned eye carries it — the ports are known with the eye at rest — so the shaft's axis
-// runs through the cannula the instrument is in.
-bool SimulationModel::map_tracked(std::size_t i, const TrackedPose& tracked, InstrumentPose& pose) const {
-  Port port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[i];
-  if (eye_tracked_) {
-    port.position_mm = eye_rotation_ * port.position_mm;
-    port.outward = eye_rotation_ * port.outward;
-  }
-  return map_through_port(tracked, port, core::Quat::Identity(), config_.calibration[i], pose);
-}
-
 bool SimulationModel::apply_tracker(const telemetry::TrackerSample& t) {
   if (t.instrument_id >= kTrackedInstruments) return false;
   InstrumentSlot& slot = instruments_[t.instrument_id];
   if (slot.frozen) return true;  // a frozen instrument ignores its (late) samples
   InstrumentPose pose;
-  const TrackedPose tracked = tracked_pose(t);
-  if (!map_tracked(t.instrument_id, tracked, pose)) return false;
+  // In the fixture frame: the instrument system applies the eye's rotation itself. The port is where
+  // the turned eye carries it (the ports are known with the eye at rest), so the shaft's axis runs
+  // through the cannula the instrument is in.
+  const std::size_t i = t.instrument_id;
+  Port port = config_.measured_ports[i] ? *config_.measured_ports[i] : case_->tracker_ports[i];
+  if (eye_tracked_) {
+    port.position_mm = eye_rotation_ * port.position_mm;
+    port.outward = eye_rotation_ * port.outward;
+  }
+  if (!map_through_port(tracked_pose(t), port, core::Quat::Identity(), config_.calibration[i], pose)) return false;
   slot.present = true;
-  slot.port = case_->tracker_port_ids[static_cast<std::size_t>(t.instrument_id)];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
+  slot.port = case_->tracker_port_ids[i];  // the eye's port: 0 infusion, 1 working_1, 2 working_2
   slot.tool_type = t.tool_type;
-  slot.tracked = tracked;
   slot.pose = pose;
   return true;
 }
@@ -202,14 +197,6 @@ core::StepReport SimulationModel::step() {
     in.actuation = slot.pose.actuation;
     return in;
   };
-  // Each held instrument mapped through its port as the eye stands for this step (a fixture sample
-  // may have come after the tracker's), so the shaft and the eye's rotation the core applies agree.
-  if (eye_tracked_) {
-    for (std::size_t i = 0; i < instruments_.size(); ++i) {
-      InstrumentSlot& slot = instruments_[i];
-      if (slot.present && !slot.frozen) (void)map_tracked(i, slot.tracked, slot.pose);
-    }
-  }
   for (std::uint32_t i = 0; i < sys.instrument_count(); ++i) {
     core::InstrumentInput in;
     if (static_cast<int>(i) == case_->light_pipe) {

@@ -52,8 +52,7 @@ struct InstrumentSlot {
   bool frozen = false;  // its tracker is lost: held where it was
   int port = -1;
   int tool_type = 0;
-  TrackedPose tracked;  // its last sample, as the tracker gave it
-  InstrumentPose pose;  // that sample mapped through the port (SimulationModel::map_tracked)
+  InstrumentPose pose;
 };
 
 class SimulationModel {
@@ -118,7 +117,6 @@ class SimulationModel {
  private:
   // One per kind of input (apply() has checked that every value is finite).
   bool apply_tracker(const telemetry::TrackerSample& t);
-  bool map_tracked(std::size_t i, const TrackedPose& tracked, InstrumentPose& pose) const;
   bool apply_fixture(const telemetry::EyeFixtureSample& e);
   bool apply_pedal(const telemetry::PedalSample& p);
   bool apply_link(std::int32_t channel, const telemetry::LinkChange& link);

@@ -147,6 +147,17 @@ const vitreo_lcm::device_input_t* last_input(const std::vector<vitreo_lcm::devic
   return found;
 }
 
+// The last input of `kind` recorded before `before` (the rig applies them in this order).
+const vitreo_lcm::device_input_t* last_input_before(const std::vector<vitreo_lcm::device_input_t>& inputs, int kind,
+                                                    const vitreo_lcm::device_input_t* before) {
+  const vitreo_lcm::device_input_t* found = nullptr;
+  for (const auto& in : inputs) {
+    if (&in == before) break;
+    if (in.device_kind == kind) found = &in;
+  }
+  return found;
+}
+
 }  // namespace
 
 // instrument_state_t: the eye frame (the picture's), the shaft axis from the tip to the handle, the
@@ -199,10 +210,13 @@ TEST(TelemetryContract, InstrumentStateIsInTheEyeFrameWithTheShaftTowardTheHandl
     EXPECT_LT((tip - tip_eye).norm(), 1e-6) << "eye frame: " << tip.transpose() << " expected " << tip_eye.transpose();
     if (s.port_id >= 0) {
       ++inserted;
-      // Through the port: the shaft runs from the eye's port, where the turned eye carries it
-      // (q · port in the fixture frame), to the tip — so in the eye frame, from the tip toward the
-      // handle it points at the eye's own port.
-      const core::Vec3 to_handle = q.conjugate() * (q * port - tip_fixture).normalized();
+      // Through the port: the rig maps the tracker's sample through the port where the eye, as the
+      // fixture last read it before that sample, carries it (q_then · port in the fixture frame),
+      // and the core turns the shaft into the eye frame with the step's rotation q.
+      const auto* eye_then = last_input_before(inputs, 2, tracker);
+      const core::Quat q_then = eye_then ? core::Quat(eye_then->values[0], eye_then->values[1], eye_then->values[2], eye_then->values[3]).normalized()
+                                         : core::Quat::Identity();
+      const core::Vec3 to_handle = q.conjugate() * (q_then * port - tip_fixture).normalized();
       const core::Vec3 axis(s.shaft_axis[0], s.shaft_axis[1], s.shaft_axis[2]);
       EXPECT_LT((axis - to_handle).norm(), 1e-6) << "tip to handle: " << axis.transpose() << " expected " << to_handle.transpose();
       // The insertion: from the port to the tip along the shaft, with the eye's port where it is.
