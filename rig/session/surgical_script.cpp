@@ -261,7 +261,7 @@ SurgicalScript parse_surgical_script(const std::string& text, const std::string&
       }
       e.at_s = *at;
       e.duration_s = r.number("duration_s", 0.05, 600).value_or(e.duration_s);
-      // The fixture turns about ±25° either way (PROTOCOL.md's eyeball fixture).
+      // ±25°: an eye held by the instruments in its ports is not turned farther in surgery.
       e.yaw_deg = r.number("yaw_deg", -25, 25).value_or(0);
       e.pitch_deg = r.number("pitch_deg", -25, 25).value_or(0);
       r.refuse_unknown("at_s, duration_s, yaw_deg, pitch_deg");
@@ -434,6 +434,11 @@ class LandmarkResolver {
 // The tracker's orientation for a twist `roll_deg` about the shaft from `port` to `tip`, as the Z-Y-X
 // Euler angles the emulator takes: the instrument's x axis at roll_deg from the eye's +z projected
 // across the shaft (rig/input/port_pivot.cpp measures it the same way), its z axis along the shaft.
+// A rotation's Z-Y-X Euler angles in degrees (yaw, pitch, roll), the emulator's tracker convention.
+Vec3 euler_zyx_deg(const Eigen::Matrix3d& m) {
+  return Vec3(std::atan2(m(1, 0), m(0, 0)), std::asin(std::clamp(-m(2, 0), -1.0, 1.0)), std::atan2(m(2, 1), m(2, 2))) / kDeg;
+}
+
 Vec3 euler_for_roll(const Vec3& port, const Vec3& tip, double roll_deg) {
   Vec3 axis = tip - port;
   if (axis.norm() < 1e-9) return Vec3::Zero();
@@ -448,10 +453,7 @@ Vec3 euler_for_roll(const Vec3& port, const Vec3& tip, double roll_deg) {
   R.col(0) = x;
   R.col(1) = y;
   R.col(2) = axis;
-  const double yaw = std::atan2(R(1, 0), R(0, 0));
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  const double roll = std::atan2(R(2, 1), R(2, 2));
-  return Vec3(yaw, pitch, roll) / kDeg;
+  return euler_zyx_deg(R);
 }
 
 std::string tracker_key(double t_ms, const Vec3& p, double jaws, const Vec3& euler_deg = Vec3::Zero()) {
@@ -496,9 +498,7 @@ class EyeTurns {
     const core::Quat r = rotation(yaw, pitch);
     const core::Quat hand = Eigen::AngleAxisd(euler_deg.x() * kDeg, Vec3::UnitZ()) * Eigen::AngleAxisd(euler_deg.y() * kDeg, Vec3::UnitY()) *
                             Eigen::AngleAxisd(euler_deg.z() * kDeg, Vec3::UnitX());
-    const Eigen::Matrix3d m = (r * hand).toRotationMatrix();
-    const Vec3 euler(std::atan2(m(1, 0), m(0, 0)), std::asin(std::clamp(-m(2, 0), -1.0, 1.0)), std::atan2(m(2, 1), m(2, 2)));
-    return tracker_key(t_s * 1e3, r * p, jaws, euler / kDeg);
+    return tracker_key(t_s * 1e3, r * p, jaws, euler_zyx_deg((r * hand).toRotationMatrix()));
   }
 
  private:
