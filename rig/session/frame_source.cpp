@@ -489,7 +489,9 @@ void FrameBuilder::add_overlay(const ViewSnapshot& snap, const CaseVisuals& cv, 
   }
   if (!cats.empty()) ov.lines.push_back(cats);
   for (std::uint32_t i = 0; i < o.n_criteria; ++i) {
-    std::snprintf(line, sizeof line, "%s %s %.0f%%%s", upper(o.criterion_kind[i] ? o.criterion_kind[i] : "?").c_str(),
+    // Progress toward the criterion's goal (membrane freed 0.51 of a 0.5 goal reads 100 %), said so:
+    // a bare "100%" read as the whole membrane freed.
+    std::snprintf(line, sizeof line, "%s %s %.0f%% OF GOAL%s", upper(o.criterion_kind[i] ? o.criterion_kind[i] : "?").c_str(),
                   upper(o.criterion_target[i]).c_str(), 100.0 * o.criterion_progress[i], o.criterion_met[i] ? "  MET" : "");
     ov.lines.emplace_back(line);
   }
