@@ -3,6 +3,7 @@
 // deterministic, bad input is refused, and a step that would go non-finite is rolled back.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -494,6 +495,31 @@ TEST(SolverBehaviour, AStalkHoldsTwoLayersApartAtItsLengthAndStretchesByHookesLa
     EXPECT_NEAR(pulled.gap(v), 0.5 + 100.0 / StalkedLayers::kStiffness, 2e-3) << "corner " << v;
     EXPECT_NEAR(pulled.world.attachment_force(pulled.stalks[v]), 100.0, 2.0) << "corner " << v;
   }
+}
+
+// Tissue taken away under an attachment (the vitrector removing a membrane's triangles) lets the
+// attachment go where it stood: the event is placed at its base, which is still there (it used to
+// be placed at the origin, and the debrief drew those at the centre of the eye).
+TEST(SolverBehaviour, AnAttachmentWhoseTissueIsRemovedBreaksWhereItStood) {
+  StalkedLayers layers(0.5, 0.5, 0.0);
+  for (int i = 0; i < 100; ++i) ASSERT_TRUE(layers.world.step(1e-3).ok);
+  Surface& up = layers.world.surface(layers.upper);
+  ASSERT_TRUE(up.remove_triangle(up.triangle_id(0)).status);
+  ASSERT_EQ(up.vertex_count(), 0u);
+  const StepReport r = layers.world.step(1e-3);
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.attachments_broken, 3u);
+  const Surface& low = layers.world.surface(layers.lower);
+  std::size_t seen = 0;
+  for (const TissueEvent& e : layers.world.events()) {
+    if (e.kind != TissueEventKind::kAttachmentBroken) continue;
+    const auto it = std::find(layers.stalks.begin(), layers.stalks.end(), e.item);
+    ASSERT_NE(it, layers.stalks.end());
+    const auto corner = static_cast<std::uint32_t>(it - layers.stalks.begin());  // added corner by corner
+    EXPECT_LT((e.position_mm - low.position(corner)).norm(), 1e-12) << "stalk " << corner;
+    ++seen;
+  }
+  EXPECT_EQ(seen, 3u);
 }
 
 TEST(SolverBehaviour, ACutSeversTheStalksInItsReachAndNothingElse) {
