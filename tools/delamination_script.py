@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """delamination_script.py SITES CASE MEMBRANE OUT [--kind K] [--tip-h MM] [--roll DEG] [--slope-deg DEG]
                           [--speed MM_S] [--tremor MM --seed N] [--side MM] [--deeper MM]
-                          [--order along|back|far-first] [--passes 1|2] [--summary TEXT] [--comment FILE]
+                          [--order along|back|far-first] [--passes N] [--summary TEXT] [--comment FILE]
 
 Writes a surgical script (scenes/scripts/README.md) that delaminates an elevated band with horizontal
 scissors: for each stalk, the jaws are opened 1.4 mm back along the shaft, slid in along it until the
@@ -51,7 +51,7 @@ p.add_argument('--summary', default='')
 p.add_argument('--side', type=float, default=0.1, help='each stalk: closes this far to either side of it (mm)')
 p.add_argument('--deeper', type=float, default=0.15, help='then one this far deeper, away from the port (mm)')
 p.add_argument('--order', default='along', choices=['along', 'back', 'far-first'], help='along the band, back along it, or the far row (away from the port) first')
-p.add_argument('--passes', type=int, default=1, help='2: then back along the band again, for stalks a close missed')
+p.add_argument('--passes', type=int, default=1, help='2: then back along the band again, for stalks a close missed; 3: and along it once more')
 p.add_argument('--comment', help='a file whose text heads the script (its comment block)')
 a = p.parse_args()
 
@@ -86,7 +86,7 @@ def wp(site, t, c, extra):
 
 
 body = ''; T = 2.0
-plan = order + (order[::-1] if a.passes > 1 else [])
+plan = [s for k in range(a.passes) for s in (order if k % 2 == 0 else order[::-1])]  # there, back, there...
 for site, ts, cs, _, _ in plan:
     # In the site's frame the port lies straight along toward_port_mm: the shaft's sideways is across.
     t0, c0 = ts - back, cs
