@@ -28,7 +28,7 @@ The shipped scripts, from `vitreo-cases sites scenes/CASE.toml BAND --retina-ver
   traction_anteroposterior (ap_band) expert: --roll 15.7
                                      clumsy: --roll 15.7 --tip-h 0.12 --speed 3 --tremor 0.02 --seed 3
   traction_circumferential (band)    expert: --roll 26.2 --order far-first --passes 2
-                                     clumsy: the expert's, with --tip-h 0.12 --speed 3 --tremor 0.02 --seed 3
+                                     clumsy: the expert's, with --tip-h 0.18 --speed 3 --tremor 0.03 --seed 3
 each with --kind, --summary and the file's own comment block (--comment).
 
 Why this shape: the jaws (1 mm, 25° half-opening) cut a stalk only where they sweep across it while
