@@ -133,9 +133,9 @@ double forceps_lift_force_un(int cells, int substeps, int iterations) {
 
 // What the surgeon's hand feels is the material's, not the solver's: at the rig's settings (2
 // substeps × 1 iteration, 1 ms) a forceps lift of a sheet meshed at 0.2 mm (finer than the low
-// membrane case's own 20k membrane, about 0.24 mm) pulls with the force a converged solve gives (4 × 2). (At 0.133 mm it still
-// does; on a 0.1 mm mesh, finer than any case's, the rig's settings pull 5× too hard:
-// core/tissue/MEASUREMENTS.md.)
+// membrane case's own 20k membrane, about 0.24 mm) pulls with the force a converged solve gives
+// (4 × 2). At 0.133 mm it still does; on a 0.1 mm mesh, finer than any case's, the rig's settings
+// pull 5× too hard (core/tissue/MEASUREMENTS.md, 2026-11-27).
 TEST(Instruments, AForcepsLiftPullsWithTheConvergedForceAtTheRigsSettings) {
   const double rig = forceps_lift_force_un(30, 2, 1);
   const double converged = forceps_lift_force_un(30, 4, 2);
