@@ -94,6 +94,28 @@ TEST(Instruments, GaugesAndPivotKinematics) {
 
 namespace {
 
+// Straight down through the port above the scene, `offset` across from the axis.
+InstrumentInput down_to_beside(const Vec3& offset, double tip_z, double actuation) {
+  InstrumentInput in = down_to(tip_z, actuation);
+  in.tip_fixture_mm += offset;
+  return in;
+}
+
+// The forceps descend to 0.05 mm above the sheet at z = 0, jaws open, and close over 20 steps;
+// false if the simulation refused an input.
+bool descend_and_close(Simulation& sys, const Vec3& offset) {
+  bool accepted = true;
+  for (int i = 0; i < 50; ++i) {
+    accepted = sys.set_input(0, down_to_beside(offset, 1.0 - 0.95 * i / 49.0, 0.0)) && accepted;
+    sys.step(kDt);
+  }
+  for (int i = 0; i <= 20; ++i) {
+    accepted = sys.set_input(0, down_to_beside(offset, 0.05, i / 20.0)) && accepted;
+    sys.step(kDt);
+  }
+  return accepted;
+}
+
 // The force in the jaws lifting a border-anchored 6 mm sheet (`cells` per side) by its centre
 // 0.6 mm at 3 mm/s, then holding it there 0.1 s.
 double forceps_lift_force_un(int cells, int substeps, int iterations) {
@@ -107,22 +129,10 @@ double forceps_lift_force_un(int cells, int substeps, int iterations) {
   o.ports_mm = {Vec3(0, 0, 10)};
   Simulation sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
   const Vec3 offset(0.013, -0.021, 0.0);
-  auto at = [&](double z, double act) {
-    InstrumentInput in = down_to(z, act);
-    in.tip_fixture_mm += offset;
-    return in;
-  };
-  for (int i = 0; i < 50; ++i) {
-    EXPECT_TRUE(sys.set_input(0, at(1.0 - 0.95 * i / 49.0, 0.0)));
-    sys.step(kDt);
-  }
-  for (int i = 0; i <= 20; ++i) {
-    EXPECT_TRUE(sys.set_input(0, at(0.05, i / 20.0)));
-    sys.step(kDt);
-  }
+  EXPECT_TRUE(descend_and_close(sys, offset));
   EXPECT_NE(sys.instrument(0).grip, kNone);
   for (int i = 1; i <= 300; ++i) {
-    EXPECT_TRUE(sys.set_input(0, at(0.05 + 0.6 * std::min(i, 200) / 200.0, 1.0)));
+    EXPECT_TRUE(sys.set_input(0, down_to_beside(offset, 0.05 + 0.6 * std::min(i, 200) / 200.0, 1.0)));
     sys.step(kDt);
   }
   EXPECT_NE(sys.instrument(0).grip, kNone);
@@ -153,19 +163,8 @@ TEST(Instruments, ForcepsLiftAMembraneAtTheGraspedPoint) {
   Simulation sys(world, o, {{InstrumentKind::kForceps, Gauge::k23, 0, {}}});
   // Off the mesh's vertices on purpose: the grasp is at the point between the jaws, not a vertex.
   const Vec3 offset(0.07, -0.04, 0.0);
-  auto at = [&](double z, double act) {
-    InstrumentInput in = down_to(z, act);
-    in.tip_fixture_mm += offset;
-    return in;
-  };
-  for (int i = 0; i < 50; ++i) {  // descend to just above the membrane, jaws open
-    ASSERT_TRUE(sys.set_input(0, at(1.0 - 0.95 * i / 49.0, 0.0)));
-    sys.step(kDt);
-  }
-  for (int i = 0; i <= 20; ++i) {  // close the handle
-    ASSERT_TRUE(sys.set_input(0, at(0.05, i / 20.0)));
-    sys.step(kDt);
-  }
+  const auto at = [&](double z, double act) { return down_to_beside(offset, z, act); };
+  ASSERT_TRUE(descend_and_close(sys, offset));
   ASSERT_NE(sys.instrument(0).grip, kNone);
   const GripDescription g = world.grip(sys.instrument(0).grip);
   const Vec3 grasped = world.grip_point(sys.instrument(0).grip);
