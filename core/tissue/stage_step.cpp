@@ -175,10 +175,13 @@ void TissueWorld::break_attachments() {
       // Where it was: its tissue end; when an instrument took that away (a stale attachment), the
       // end that is left — the base under it, or the world point it held to.
       const Surface& sa = *surfaces_[at.d.surface_a];
-      const bool world_end = at.d.surface_b == AttachmentDescription::kWorld;
-      const Vec3 p = sa.is_current(at.a)                                    ? sa.position(at.a.index)
-                     : !world_end && surfaces_[at.d.surface_b]->is_current(at.b) ? surfaces_[at.d.surface_b]->position(at.b.index)
-                                                                                 : at.d.world_point_mm;
+      const Surface* sb = at.d.surface_b == AttachmentDescription::kWorld ? nullptr : surfaces_[at.d.surface_b].get();
+      Vec3 p = at.d.world_point_mm;
+      if (sa.is_current(at.a)) {
+        p = sa.position(at.a.index);
+      } else if (sb && sb->is_current(at.b)) {
+        p = sb->position(at.b.index);
+      }
       if (events_.size() < events_.capacity()) {
         events_.push_back({TissueEventKind::kAttachmentBroken, at.d.surface_a, i, p, at.peak_force_un});
       }
