@@ -174,6 +174,15 @@ void SceneDescription::validate() const {
   if (working_port != "working_1" && working_port != "working_2") {
     throw InvalidArgument("instruments.working_port '" + working_port + "' is not a working port (working_1, working_2)");
   }
+  if (second_hand != "light_pipe" && second_hand != "forceps" && second_hand != "pick" && second_hand != "scissors") {
+    throw InvalidArgument("instruments.second_hand '" + second_hand + "' is not one the other hand holds (light_pipe, forceps, pick, scissors)");
+  }
+  if (second_hand != "light_pipe") {
+    if (!view.chandelier) throw InvalidArgument("instruments.second_hand '" + second_hand + "' leaves no hand for the light pipe: set view.chandelier = true");
+    if (std::find(instruments.begin(), instruments.end(), "light_pipe") != instruments.end()) {
+      throw InvalidArgument("instruments: 'light_pipe' is available but the other hand holds the " + second_hand);
+    }
+  }
   std::set<std::string> tear_names;
   for (const auto& t : tears) tear_names.insert(t.name);
   for (const auto& g : guides) {

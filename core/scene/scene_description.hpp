@@ -167,6 +167,11 @@ struct SceneDescription {
   // pipe takes the other. A break on the same side as working_1 is reached across the eye from
   // working_2, as a surgeon switches hands for it (the near port meets it at a grazing angle).
   std::string working_port = "working_1";
+  // What the other hand holds through the other working port: the light pipe, or — with a
+  // chandelier lighting the cavity instead (view.chandelier) — a second instrument for bimanual
+  // membrane work ("forceps", "pick" or "scissors": tools its own handle works; the pedals work the
+  // working hand's). A second-hand instrument is its own, besides the working hand's `available`.
+  std::string second_hand = "light_pipe";
   std::vector<GuideSpec> guides;
   std::vector<CriterionSpec> criteria;
   // [proficiency] pass_score: the final score (0..100) an attempt must reach to pass this case. The

@@ -391,6 +391,9 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     d.instruments = t->strings("available");
     t->string("working_port", d.working_port);
     if (d.working_port != "working_1" && d.working_port != "working_2") t->fail("working_port", "expected \"working_1\" or \"working_2\"");
+    t->string("second_hand", d.second_hand);
+    if (d.second_hand != "light_pipe" && d.second_hand != "forceps" && d.second_hand != "pick" && d.second_hand != "scissors")
+      t->fail("second_hand", "expected \"light_pipe\", \"forceps\", \"pick\" or \"scissors\"");
     t->finish();
     const auto& known = core::known_instruments();
     for (const auto& i : d.instruments) {
@@ -538,6 +541,14 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     });
   }
   root.finish();
+  // The other hand's instrument needs the chandelier's light (two tables, one rule): said at the key.
+  if (d.second_hand != "light_pipe") {
+    if (auto t = root.table("instruments")) {
+      if (!d.view.chandelier) t->fail("second_hand", "the other hand holds the " + d.second_hand + ", so no light pipe lights the cavity: set [view] chandelier = true");
+      if (std::find(d.instruments.begin(), d.instruments.end(), "light_pipe") != d.instruments.end())
+        t->fail("available", "'light_pipe' has no hand: the other hand holds the " + d.second_hand);
+    }
+  }
   validated(root, [&] { d.validate(); });
   return d;
 }

@@ -79,6 +79,14 @@ bool instrument_kind_of_tool_type(int tool_type, core::InstrumentKind& out) {
   }
 }
 
+int tool_type_of(core::InstrumentKind kind) {
+  for (int type = 1; type < 64; ++type) {
+    core::InstrumentKind k;
+    if (instrument_kind_of_tool_type(type, k) && k == kind) return type;
+  }
+  return VP_TOOL_NONE;
+}
+
 std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>& cases, int index,
                                            const scene_io::CaseLoadOptions& options) {
   if (index < 0 || index >= static_cast<int>(cases.size())) {
@@ -100,11 +108,11 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   if (!infusion || !w1 || !w2) throw core::InvalidArgument("case " + s.description.name + ": the eye has no three-port layout");
   const bool swapped = s.description.working_port == "working_2";
   out->tracker_port_names[kToolTracker] = swapped ? "working_2" : "working_1";
-  out->tracker_port_names[kLightPipeTracker] = swapped ? "working_1" : "working_2";
+  out->tracker_port_names[kSecondHandTracker] = swapped ? "working_1" : "working_2";
   out->tracker_port_ids[kToolTracker] = swapped ? 2 : 1;
-  out->tracker_port_ids[kLightPipeTracker] = swapped ? 1 : 2;
+  out->tracker_port_ids[kSecondHandTracker] = swapped ? 1 : 2;
   out->tracker_ports[kToolTracker] = pivot_of(swapped ? *w2 : *w1);
-  out->tracker_ports[kLightPipeTracker] = pivot_of(swapped ? *w1 : *w2);
+  out->tracker_ports[kSecondHandTracker] = pivot_of(swapped ? *w1 : *w2);
 
   core::InstrumentSceneOptions o;
   o.ports_mm = {pivot_of(*infusion).position_mm, out->tracker_ports[0].position_mm, out->tracker_ports[1].position_mm};
@@ -139,11 +147,18 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
     d.port = 1;
     instruments.push_back(d);
   }
-  if (light) {
+  // The other hand: the light pipe when the case offers one, or its second-hand instrument (an
+  // instance of its own: the working hand may hold forceps too).
+  core::InstrumentKind second = core::InstrumentKind::kLightPipe;
+  const bool second_tool = s.description.second_hand != "light_pipe";
+  if (second_tool && !instrument_kind(s.description.second_hand, second))
+    throw core::InvalidArgument("case " + s.description.name + ": the other hand cannot hold '" + s.description.second_hand + "'");
+  if (light || second_tool) {
     core::InstrumentDescription d;
-    d.kind = core::InstrumentKind::kLightPipe;
+    d.kind = second;
     d.port = 2;
-    out->light_pipe = static_cast<int>(instruments.size());
+    out->second_hand = static_cast<int>(instruments.size());
+    out->second_hand_kind = second;
     instruments.push_back(d);
   }
   std::vector<std::uint32_t> surfaces;
@@ -161,7 +176,7 @@ std::string describe_instruments(const PreparedCase& c) {
   ss << "tracker 0 (" << c.tracker_port_names[kToolTracker] << "): ";
   for (std::size_t i = 0; i < c.tools.size(); ++i) ss << (i ? ", " : "") << core::to_string(c.tools[i]);
   if (c.tools.empty()) ss << "none";
-  ss << " (the handpiece's tool type, else the instrument switch, picks); tracker 1 (" << c.tracker_port_names[kLightPipeTracker] << "): " << (c.light_pipe >= 0 ? "light pipe" : "none");
+  ss << " (the handpiece's tool type, else the instrument switch, picks); tracker 1 (" << c.tracker_port_names[kSecondHandTracker] << "): " << (c.second_hand < 0 ? std::string("none") : c.second_hand_is_light_pipe() ? std::string("light pipe") : std::string(core::to_string(c.second_hand_kind)) + " (lit by the chandelier)");
   return ss.str();
 }
 

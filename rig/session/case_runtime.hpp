@@ -11,8 +11,10 @@
 //                          the infusion, in the order the case lists them, through port "working_1"
 //                          (or "working_2" when the case's instruments.working_port says so);
 //                          the pedal's instrument-change switch cycles through them
-//   tracker instrument 1 → the light pipe through the other working port (when no tracker drives it, it is held
-//                          there aimed at the case's region of interest)
+//   tracker instrument 1 → the other hand's instrument through the other working port: the light pipe
+//                          (when no tracker drives it, it is held there aimed at the case's region of
+//                          interest), or the case's instruments.second_hand (forceps, pick or scissors:
+//                          bimanual work under a chandelier)
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -29,7 +31,7 @@
 namespace vitreo::rig {
 
 inline constexpr int kToolTracker = 0;
-inline constexpr int kLightPipeTracker = 1;
+inline constexpr int kSecondHandTracker = 1;
 inline constexpr int kTrackedInstruments = 2;
 
 struct PreparedCase {
@@ -41,7 +43,9 @@ struct PreparedCase {
   // with the case so a switch swaps them with it and nothing allocates on the physics thread.
   std::unique_ptr<core::SessionMetrics> metrics;
   std::vector<core::InstrumentKind> tools;  // simulation instruments 0..tools.size()-1
-  int light_pipe = -1;                      // simulation instrument index of the light pipe (-1: none)
+  int second_hand = -1;                     // simulation instrument index of tracker 1's instrument (-1: none)
+  core::InstrumentKind second_hand_kind = core::InstrumentKind::kLightPipe;  // what it is
+  bool second_hand_is_light_pipe() const { return second_hand >= 0 && second_hand_kind == core::InstrumentKind::kLightPipe; }
   Port tracker_ports[kTrackedInstruments];  // pivot of each tracked instrument
   std::string tracker_port_names[kTrackedInstruments];  // the eye's port each goes through
   int tracker_port_ids[kTrackedInstruments] = {1, 2};   // its index: 0 infusion, 1 working_1, 2 working_2
@@ -67,6 +71,10 @@ bool instrument_kind(const std::string& name, core::InstrumentKind& out);
 // for 0 (a universal handpiece that names no tool), 8 (the infusion is no held instrument) and codes
 // past the last.
 bool instrument_kind_of_tool_type(int tool_type, core::InstrumentKind& out);
+
+// The tool type a handpiece of this kind reports (PROTOCOL.md, POSE_SAMPLE): the inverse of
+// instrument_kind_of_tool_type.
+int tool_type_of(core::InstrumentKind kind);
 
 // Loads case `index` of `cases` and builds its instruments. Throws like scene_io::load_case.
 std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>& cases, int index,

@@ -39,18 +39,18 @@ const std::vector<core::InstrumentEvent> kNoInstrumentEvents;
 const std::vector<core::TissueEvent> kNoTissueEvents;
 
 // The simulated instrument a hand (tracker) drives now: the working hand's selected tool, the other
-// hand's light pipe; -1 when the case has none for it.
+// hand's light pipe or second-hand tool; -1 when the case has none for it.
 int driven_instrument(const SimulationModel& model, std::size_t tracker) {
   const int sim = tracker == static_cast<std::size_t>(kToolTracker)         ? model.selected_tool()
-                  : tracker == static_cast<std::size_t>(kLightPipeTracker) ? model.current_case().light_pipe
+                  : tracker == static_cast<std::size_t>(kSecondHandTracker) ? model.current_case().second_hand
                                                                             : -1;
   return sim >= 0 && static_cast<std::uint32_t>(sim) < model.simulation().instrument_count() ? sim : -1;
 }
 
-// The hand (tracker) a simulated instrument belongs to: the light pipe is the other hand's, every
-// tool the working hand's (only the one in the hand is inside the eye).
+// The hand (tracker) a simulated instrument belongs to: the light pipe or second-hand tool is the other
+// hand's, every other tool the working hand's (only the one in the hand is inside the eye).
 int hand_of(const SimulationModel& model, std::uint32_t instrument) {
-  return static_cast<int>(instrument) == model.current_case().light_pipe ? kLightPipeTracker : kToolTracker;
+  return static_cast<int>(instrument) == model.current_case().second_hand ? kSecondHandTracker : kToolTracker;
 }
 
 // The step's telemetry from the model's state (rig/telemetry/telemetry_mapping.hpp says what each

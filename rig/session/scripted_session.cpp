@@ -14,8 +14,8 @@ std::vector<DeviceSpec> simulated_devices(const SurgicalScript& script) {
                                      {"pedals", DeviceRole::pedals, "sim:pedals?transport=pty", 2, 0, 0, kScriptsTunedAtHz, ""},
                                      {"eyeball", DeviceRole::eyeball, "sim:eyeball?transport=pty", 3, 0, 0, kScriptsTunedAtHz, ""}};
   for (const auto& h : script.hands) {
-    if (h.tracker == kLightPipeTracker)
-      devices.push_back({"tracker-1", DeviceRole::tracker, "sim:tracker?transport=pty", 4, kLightPipeTracker, 0, 0, ""});
+    if (h.tracker == kSecondHandTracker)
+      devices.push_back({"tracker-1", DeviceRole::tracker, "sim:tracker?transport=pty", 4, kSecondHandTracker, 0, 0, ""});
   }
   // At PROTOCOL.md's 500 Hz: no script was tuned with it at another rate.
   if (works_microscope(script)) devices.push_back({kMicroscopePedalDevice, DeviceRole::pedals, "sim:pedals?transport=pty", 5, 0, 0, 0, ""});

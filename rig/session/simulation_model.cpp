@@ -199,18 +199,20 @@ core::StepReport SimulationModel::step() {
   };
   for (std::uint32_t i = 0; i < sys.instrument_count(); ++i) {
     core::InstrumentInput in;
-    if (static_cast<int>(i) == case_->light_pipe) {
-      const InstrumentSlot& slot = instruments_[kLightPipeTracker];
+    if (static_cast<int>(i) == case_->second_hand) {
+      const InstrumentSlot& slot = instruments_[kSecondHandTracker];
       if (slot.present) {
         in = tracked(slot);
-      } else {
+      } else if (case_->second_hand_is_light_pipe()) {
         // Untracked light pipe: held 6 mm into its port, aimed at the case's region of interest.
-        const core::Vec3 port = case_->tracker_ports[kLightPipeTracker].position_mm;
+        const core::Vec3 port = case_->tracker_ports[kSecondHandTracker].position_mm;
         in = core::InstrumentInput::through_port(port, (case_->focus_mm - port).normalized(), 6.0);
         if (eye_tracked_) {  // held in the eye's port, it turns with the eye
           in.tip_fixture_mm = eye_rotation_ * in.tip_fixture_mm;
           in.axis_fixture = eye_rotation_ * in.axis_fixture;
         }
+      } else {
+        in.present = false;  // an untracked second-hand tool stays outside the eye
       }
     } else if (static_cast<int>(i) == tool && instruments_[kToolTracker].present) {
       in = tracked(instruments_[kToolTracker]);
@@ -221,7 +223,8 @@ core::StepReport SimulationModel::step() {
     in.cut_rate_cpm = c.cut_rate_cpm;  // the vitrector's cutter, from the pedal (controls.hpp)
     // The laser switch fires the tool in the working hand; the light pipe's pick has its own switch
     // (it used to stick out at every shot, then not at all).
-    in.trigger = static_cast<int>(i) == case_->light_pipe ? c.pick_out : static_cast<int>(i) == tool && c.laser_fire;
+    in.trigger = static_cast<int>(i) == case_->second_hand ? case_->second_hand_is_light_pipe() && c.pick_out
+                                                           : static_cast<int>(i) == tool && c.laser_fire;
     in.laser_power_mw = laser_.power_mw;  // the console's settings: each shot one pulse of these
     in.laser_duration_s = 1e-3 * laser_.duration_ms;
     in.light_power_mw = 5.0 + 10.0 * c.light_level;

@@ -653,8 +653,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
 
   for (const ScriptHand& hand : script.hands) {
     const std::string hand_key = "hand[" + std::to_string(&hand - script.hands.data()) + "]";
-    if (hand.tracker == kLightPipeTracker && c.light_pipe < 0)
-      landmarks.fail(hand.line, hand_key + ".tracker", "the case has no light pipe for the second hand");
+    if (hand.tracker == kSecondHandTracker && c.second_hand < 0)
+      landmarks.fail(hand.line, hand_key + ".tracker", "the case has nothing for the second hand (no light pipe, no instruments.second_hand)");
     if (hand.tracker == kToolTracker && tools.empty()) landmarks.fail(hand.line, hand_key + ".tracker", "the case has no tools for the working hand");
     const Port& port = c.tracker_ports[hand.tracker];
     Vec3 pos = port.position_mm + 2.0 * port.outward;  // the tip waits outside its cannula
@@ -745,8 +745,8 @@ ResolvedScript resolve_script(const SurgicalScript& script, const PreparedCase& 
     if (eye.any() && t < eye.last_end_s()) add_segment(pos, jaws, eye.last_end_s() - t, std::nullopt);
     const std::string name = "tracker-" + std::to_string(hand.tracker);
     // The working hand holds a universal handpiece (tool type 0): the script's `tool =` picks the
-    // tool with instrument-switch presses. The other hand's handpiece is the light pipe.
-    const int tool_type = hand.tracker == kToolTracker ? VP_TOOL_NONE : VP_TOOL_LIGHT_PIPE;
+    // tool with instrument-switch presses. The other hand's handpiece is its instrument's own.
+    const int tool_type = hand.tracker == kToolTracker ? VP_TOOL_NONE : tool_type_of(c.second_hand_kind);
     std::string header = "device tracker\nrate_hz 1000\nserial " + std::to_string(1001 + hand.tracker) + "\ntool " +
                          std::to_string(tool_type) + "\ninstrument " +
                          std::to_string(hand.tracker) + "\nloop 0\nseed " + std::to_string(script.seed + static_cast<std::uint64_t>(hand.tracker)) + "\n";

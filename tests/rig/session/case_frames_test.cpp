@@ -326,9 +326,9 @@ TEST_F(CaseFrames, ALaserBurnShowsWhitishWhereTheBeamHit) {
   // Aim at attached retina beside the fovea (a 0.2 mm burn needs the microscope zoomed in to span
   // a few pixels of this small frame: zoom 4, panned there), with the light pipe on the same spot.
   const core::Vec3 aim = model.scene().eye.wall_point(8.0 * std::numbers::pi / 180.0, std::numbers::pi);
-  const core::Vec3 lp = c.tracker_ports[rig::kLightPipeTracker].position_mm;
+  const core::Vec3 lp = c.tracker_ports[rig::kSecondHandTracker].position_mm;
   const core::Vec3 tp = c.tracker_ports[rig::kToolTracker].position_mm;
-  ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kLightPipeTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
+  ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kSecondHandTracker, lp + 6.0 * (aim - lp).normalized(), 0.0)));
   ASSERT_TRUE(model.apply(rig::testing::tracker_sample(rig::kToolTracker, tp + 8.0 * (aim - tp).normalized(), 0.0)));
   const telemetry::RecordedInput zoom = rig::testing::command_input(9, 4.0);
   // The microscope over the aim (a pan command from the case's region of interest; the X–Y motor is

@@ -43,7 +43,7 @@ telemetry::RecordedInput tracker_sample(int id, const core::Vec3& tip, double ac
   s.instrument_id = static_cast<std::uint8_t>(id);
   // Tool type (PROTOCOL.md): the light pipe's hand holds a light pipe (1); the tool hand a universal
   // handpiece (0), so the case's first tool is in it, as golden/README.md says.
-  s.tool_type = id == kLightPipeTracker ? 1 : 0;
+  s.tool_type = id == kSecondHandTracker ? 1 : 0;
   telemetry::RecordedInput in;
   in.what = s;
   return in;
@@ -68,9 +68,9 @@ telemetry::RecordedInput pedal_input(int pedal, double a0, double a1, double a2,
 
 bool place_at_fixed_poses(SimulationModel& model) {
   const PreparedCase& c = model.current_case();
-  const core::Vec3 lp = c.tracker_ports[kLightPipeTracker].position_mm;
+  const core::Vec3 lp = c.tracker_ports[kSecondHandTracker].position_mm;
   const core::Vec3 tp = c.tracker_ports[kToolTracker].position_mm;
-  if (!model.apply(tracker_sample(kLightPipeTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0))) return false;
+  if (!model.apply(tracker_sample(kSecondHandTracker, lp + 6.0 * (c.focus_mm - lp).normalized(), 0.0))) return false;
   // The tool aimed at the region of interest from its port, its tip short of it (its handle a
   // third closed): working tips, the laser's aiming spot and the shadows all lie in the field.
   const core::Vec3 tool_tip = c.focus_mm - kToolClearance_mm * (c.focus_mm - tp).normalized();

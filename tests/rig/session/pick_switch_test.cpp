@@ -14,7 +14,7 @@ telemetry::RecordedInput pedal(unsigned switches) { return test::pedal_switches(
 TEST(PickSwitch, ThePickSwitchPutsTheLightPipesPickOutAndTheLaserSwitchDoesNot) {
   rig::ModelConfig mc = test::light_case("exercise_laser_tear.toml");
   rig::SimulationModel model(mc);
-  const int light = model.current_case().light_pipe;
+  const int light = model.current_case().second_hand;
   ASSERT_GE(light, 0);
   const auto light_pipe = [&]() -> const core::InstrumentState& { return model.simulation().instrument(static_cast<std::uint32_t>(light)); };
   const auto laser = [&]() -> const core::InstrumentState& { return model.simulation().instrument(0); };
@@ -40,7 +40,7 @@ TEST(PickSwitch, APedalConfigMovesThePickToAnotherSwitch) {
   rig::ModelConfig mc = test::light_case("exercise_laser_tear.toml");
   mc.pedals = rig::parse_pedal_mapping("[pedals]\npick_switch = 7\n", "rig.toml");
   rig::SimulationModel model(mc);
-  const auto light = static_cast<std::uint32_t>(model.current_case().light_pipe);
+  const auto light = static_cast<std::uint32_t>(model.current_case().second_hand);
   ASSERT_TRUE(model.apply(pedal(1u << 4)));  // the default pick switch: nothing now
   model.step();
   EXPECT_FALSE(model.simulation().instrument(light).input.trigger);

@@ -579,7 +579,8 @@ TEST(SimulationModel, TheCaseIsBuiltFromItsFileWithItsInstrumentsThroughItsPorts
   ASSERT_EQ(c.tools.size(), 4u);
   EXPECT_EQ(c.tools[0], core::InstrumentKind::kForceps);
   EXPECT_EQ(c.tools[3], core::InstrumentKind::kVitrector);
-  EXPECT_EQ(c.light_pipe, 4);
+  EXPECT_EQ(c.second_hand, 4);
+  EXPECT_TRUE(c.second_hand_is_light_pipe());
   EXPECT_EQ(model.simulation().instrument_count(), 5u);
   // The tool pivots in the eye model's working_1 sclerotomy: between its outer and inner openings.
   const core::SclerotomyPort* w1 = nullptr;

@@ -163,8 +163,8 @@ TEST_F(Resolving, ACaseCanPutTheWorkingHandThroughTheOtherPort) {
   o.retina_vertices = 5000;
   o.cache_dir = std::string(VITREO_CASE_CACHE_DIR);
   const auto c = prepare_case(swapped, 0, o);
-  EXPECT_NEAR((c->tracker_ports[kToolTracker].position_mm - case_->tracker_ports[kLightPipeTracker].position_mm).norm(), 0.0, 1e-12);
-  EXPECT_NEAR((c->tracker_ports[kLightPipeTracker].position_mm - case_->tracker_ports[kToolTracker].position_mm).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((c->tracker_ports[kToolTracker].position_mm - case_->tracker_ports[kSecondHandTracker].position_mm).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((c->tracker_ports[kSecondHandTracker].position_mm - case_->tracker_ports[kToolTracker].position_mm).norm(), 0.0, 1e-12);
   EXPECT_EQ(c->tracker_port_ids[kToolTracker], 2);
   EXPECT_EQ(case_->tracker_port_ids[kToolTracker], 1);
   EXPECT_NE(describe_instruments(*c).find("tracker 0 (working_2)"), std::string::npos) << describe_instruments(*c);
