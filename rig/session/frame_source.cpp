@@ -393,6 +393,7 @@ bool capture_view(SimulationModel& model, std::uint64_t step, double t_s, ViewSn
   out.view_center_mm[1] = scope.center_mm().y();
   out.zoom = scope.zoom();
   out.focus_mm = scope.focus_mm();
+  out.depth_of_field_mm = scope.depth_of_field_mm();
   out.field_deg = scope.field_deg();
   out.wide_angle = scope.wide_angle();
   out.image_inverted = scope.image_inverted();
@@ -696,8 +697,10 @@ render::FrameScene FrameBuilder::build(const ViewSnapshot& snap) {
   m.zoom = static_cast<float>(snap.zoom);
   m.wide_field_deg = static_cast<float>(snap.field_deg * snap.zoom);
   m.image_inverted = snap.image_inverted;
+  // Sharp where the microscope handling score calls the work in focus (Berek's depth of field,
+  // core/scene/microscope.cpp): the picture and the score agree.
   m.depth_of_field = true;
-  m.aperture_mm = 0.8f;
+  m.depth_of_field_mm = static_cast<float>(snap.depth_of_field_mm);
   m.focus_distance_mm = static_cast<float>(std::max((target_on_retina - pupil).norm() - snap.focus_mm, 1.0));
   scene.wireframe = snap.wireframe;
   scene.flat_shading = snap.flat_shading;

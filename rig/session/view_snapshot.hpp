@@ -104,6 +104,7 @@ struct ViewSnapshot {
   double view_center_mm[2] = {};  // field centre, fundus plane
   double zoom = 1.0;
   double focus_mm = 0.0;
+  double depth_of_field_mm = 0.0;  // the microscope's now (core::Microscope): the picture blurs beyond it
   double field_deg = 40.0;
   bool wide_angle = false;
   bool image_inverted = false;

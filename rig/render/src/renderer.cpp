@@ -170,6 +170,19 @@ struct DrawItem {
   float sort_distance;
 };
 
+// The composite pass's circle of confusion is coc_px = scale·|1/z − 1/focus| (kCompositeFragment).
+// A thin lens of aperture A blurs by the angle A·|1/z − 1/focus|, so scale = A · pixels per radian.
+// Given a total depth of field T instead, the scale puts the first visible blur (1 px) at the near
+// edge of the sharp zone, z = focus − T/2: scale = focus·(focus − T/2)/(T/2); the far edge, where
+// 1/z changes more slowly, is then a little under 1 px.
+float coc_scale(const Microscope& m, float focus_mm, float px_per_rad) {
+  if (m.depth_of_field_mm > 0.0f && focus_mm > 0.0f) {
+    const float half = std::min(0.5f * m.depth_of_field_mm, 0.9f * focus_mm);
+    return focus_mm * (focus_mm - half) / half;
+  }
+  return m.aperture_mm * px_per_rad;
+}
+
 }  // namespace
 
 struct StereoRenderer::Impl {
@@ -1025,8 +1038,7 @@ void StereoRenderer::Impl::render(const FrameScene& scene, StereoFrame& out, Ren
       set(cp, "u_near", ev.near_mm);
       set(cp, "u_far", ev.far_mm);
       set(cp, "u_focus", ev.focus_distance_mm);
-      // Thin lens: blur angle ≈ aperture·|1/z − 1/focus|; pixels per radian = (H/2)·P[1][1].
-      set(cp, "u_coc_scale", scene.microscope.aperture_mm * 0.5f * static_cast<float>(s.eye_height) * ev.projection.at(1, 1));
+      set(cp, "u_coc_scale", coc_scale(scene.microscope, ev.focus_distance_mm, 0.5f * static_cast<float>(s.eye_height) * ev.projection.at(1, 1)));
       glDrawArrays(GL_TRIANGLES, 0, 3);
     }
     glEnable(GL_DEPTH_TEST);

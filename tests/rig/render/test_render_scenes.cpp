@@ -407,6 +407,28 @@ TEST_F(RenderScenes, FocusBlursWhatIsOutsideTheFocalPlane) {
   EXPECT_EQ(defocused_frame.step_index, s.step_index);
 }
 
+// With a depth of field given (the simulated microscope's, which the focus score uses too), what
+// lies within half of it of the focal plane is as sharp as without any blur, and what lies well
+// beyond it blurs: the picture agrees with the score.
+TEST_F(RenderScenes, WhatLiesWithinTheDepthOfFieldIsSharpAndWhatLiesBeyondBlurs) {
+  vt::SyntheticOptions o;
+  o.retina_triangles = 3000;
+  o.instrument = false;
+  vr::FrameScene s = vt::make_scene(o);
+  s.microscope.zoom = 4.0f;  // a 7.5 mm field: the fundus in it lies within ±0.3 mm of one depth
+  const double no_dof = detail(render(s).eye(0));
+  s.microscope.depth_of_field = true;
+  s.microscope.depth_of_field_mm = 2.0f;
+  s.microscope.aperture_mm = 1000.0f;  // ignored while depth_of_field_mm is set
+  const float fundus = s.microscope.working_distance_mm + (s.microscope.target_mm.z + vt::kRetinaRadius);
+  s.microscope.focus_distance_mm = fundus - 0.4f;  // the fundus 0.4 mm behind the focal plane: inside ±1 mm
+  const double inside = detail(render(s).eye(0));
+  s.microscope.focus_distance_mm = fundus - 3.0f;  // 3 mm behind it: three times the half depth
+  const double beyond = detail(render(s).eye(0));
+  EXPECT_GT(inside, 0.97 * no_dof) << "within the depth of field nothing blurs";
+  EXPECT_LT(beyond, 0.8 * no_dof) << "beyond it the fundus blurs";
+}
+
 namespace {
 // A flat disc (membrane patch) or a sphere (gel body) as extra meshes for the synthetic scene.
 vr::MeshGeometryPtr disc_mesh(vr::Vec3 centre, float radius) {

@@ -152,7 +152,12 @@ struct Microscope {
   /// blurred when depth_of_field is on.
   float focus_distance_mm = -1.0f;
   bool depth_of_field = false;
-  float aperture_mm = 3.0f;      // depth-of-field strength
+  float aperture_mm = 3.0f;      // depth-of-field strength (thin lens), unless depth_of_field_mm is set
+  /// > 0: the blur follows this total depth of field (mm, along the view axis) instead of aperture_mm:
+  /// everything within half of it of the focal plane is sharp (circle of confusion ≤ 1 pixel), what
+  /// lies farther blurs — so the picture agrees with a depth of field computed elsewhere (the
+  /// simulation's microscope, core/scene/microscope.hpp, which also scores the focus).
+  float depth_of_field_mm = 0.0f;
   /// Seen through the eye's optics (a contact lens or a wide-angle viewing system) instead of from
   /// outside: a virtual camera at `view_point_mm` (default: on the axis at wide_distance_mm) looks at
   /// the target with a field angle of wide_field_deg / zoom.
