@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """delamination_script.py SITES CASE MEMBRANE OUT [--kind K] [--tip-h MM] [--roll DEG] [--slope-deg DEG]
                           [--speed MM_S] [--tremor MM --seed N] [--side MM] [--deeper MM]
-                          [--order along|back|far-first] [--passes N] [--summary TEXT] [--comment FILE]
+                          [--order along|back|far-first] [--passes N] [--retreat MM] [--summary TEXT] [--comment FILE]
 
 Writes a surgical script (scenes/scripts/README.md) that delaminates an elevated band with horizontal
 scissors: for each stalk, the jaws are opened 1.4 mm back along the shaft, slid in along it until the
@@ -28,7 +28,7 @@ The shipped scripts, from `vitreo-cases sites scenes/CASE.toml BAND --retina-ver
   traction_anteroposterior (ap_band) expert: --roll 15.7
                                      clumsy: --roll 15.7 --tip-h 0.12 --speed 3 --tremor 0.02 --seed 3
   traction_circumferential (band)    expert: --roll 26.2 --order far-first --passes 2
-                                     clumsy: the expert's, with --tip-h 0.18 --speed 3 --tremor 0.03 --seed 3
+                                     clumsy: the expert's, with --tip-h 0.18 --speed 3 --tremor 0.03 --seed 3 --retreat 3
 each with --kind, --summary and the file's own comment block (--comment).
 
 Why this shape: the jaws (1 mm, 25° half-opening) cut a stalk only where they sweep across it while
@@ -52,6 +52,7 @@ p.add_argument('--side', type=float, default=0.1, help='each stalk: closes this 
 p.add_argument('--deeper', type=float, default=0.15, help='then one this far deeper, away from the port (mm)')
 p.add_argument('--order', default='along', choices=['along', 'back', 'far-first'], help='along the band, back along it, or the far row (away from the port) first')
 p.add_argument('--passes', type=int, default=1, help='2: then back along the band again, for stalks a close missed; 3: and along it once more')
+p.add_argument('--retreat', type=float, default=0.0, help='after each stalk, back the open jaws this much farther out along the shaft before the next (mm)')
 p.add_argument('--comment', help='a file whose text heads the script (its comment block)')
 a = p.parse_args()
 
@@ -104,6 +105,9 @@ for site, ts, cs, _, _ in plan:
             T += 0.3
         body += wp(site, t, c, 'duration_s = 0.25\njaws = 1.0\n')
         T += 0.25
+    if a.retreat > 0:  # a novice backs out to look again before each stalk: time and path spent for nothing
+        body += wp(site, t0, c0, f'standoff_mm = {stand + a.retreat}\nspeed_mm_s = 4.0\n')
+        T += (stand + a.retreat) / 4.0
 site, ts, cs, _, _ = plan[-1]
 body += wp(site, ts - back, cs, f'standoff_mm = {stand}\nspeed_mm_s = {a.speed}\n')
 body += '[[hand.waypoint]]\nto = "port"\nabove_mm = 3.0\n'
