@@ -554,16 +554,31 @@ TEST_F(CaseCues, MicroscopeIsSimulationStateThePictureFollows) {
   const double before_px = std::hypot(d0.x - c0.x, d0.y - c0.y), after_px = std::hypot(d1.x - r1.x, d1.y - r1.y);
   std::printf("disc from the field centre: %.1f px at zoom 1, %.1f px at zoom 4\n", before_px, after_px);
   EXPECT_GT(after_px / before_px, 3.0) << "zoom magnifies about the field centre";
-  // Focus 2 mm toward the microscope: the fundus at the field centre blurs.
+  // Focus toward the microscope: within the depth of field the score calls the fundus in focus and
+  // the picture is as sharp; at the focus's end of travel (3 mm, beyond the 1.7 mm depth of field at
+  // zoom 4) both say it is not.
   const vr::Image sharp = render(zoomed, kW, kH).eye(0);
-  both(rig::testing::command_input(11, 2.0));
-  step_until(model, [&] { return model.microscope().focus_mm() == 2.0; });
-  step_until(twin, [&] { return twin.microscope().focus_mm() == 2.0; });
-  const vr::Image blurred = render(capture(model, builder), kW, kH).eye(0);
+  const double depth = model.microscope().depth_of_field_mm();
+  const core::Vec3 centre_on_fundus = model.microscope().view(model.scene().eye).target_mm;  // the retina's face there
+  auto focus_to = [&](double mm) {
+    both(rig::testing::command_input(11, mm));
+    step_until(model, [&] { return model.microscope().focus_mm() == mm; });
+    step_until(twin, [&] { return twin.microscope().focus_mm() == mm; });
+    return render(capture(model, builder), kW, kH).eye(0);
+  };
+  const vr::Image inside = focus_to(0.4 * depth);
+  const bool scored_inside = model.microscope().view(model.scene().eye).in_focus(centre_on_fundus);
+  const vr::Image blurred = focus_to(3.0);
+  const bool scored_beyond = model.microscope().view(model.scene().eye).in_focus(centre_on_fundus);
   const double ds = vt::detail(sharp, kW / 2 - 60, kH / 2 - 50, kW / 2 + 60, kH / 2 + 50);
+  const double di = vt::detail(inside, kW / 2 - 60, kH / 2 - 50, kW / 2 + 60, kH / 2 + 50);
   const double db = vt::detail(blurred, kW / 2 - 60, kH / 2 - 50, kW / 2 + 60, kH / 2 + 50);
-  std::printf("detail at the field centre: %.0f in focus, %.0f focused 2 mm above\n", ds, db);
-  EXPECT_LT(db, 0.7 * ds);
+  std::printf("depth of field %.2f mm; detail at the field centre: %.0f in focus, %.0f focused %.2f mm above, %.0f 3 mm above\n",
+              depth, ds, di, 0.4 * depth, db);
+  EXPECT_TRUE(scored_inside);
+  EXPECT_GT(di, 0.97 * ds) << "within the depth of field the picture stays sharp";
+  EXPECT_FALSE(scored_beyond);
+  EXPECT_LT(db, 0.95 * ds) << "beyond it the picture blurs (3.5 half-depths: a 3 px circle of confusion at this size)";
   EXPECT_EQ(model.state_hash(), twin.state_hash()) << "the same inputs give the same microscope, bit for bit";
   // Wide angle and its re-inverter, shading: toggles that reach the frame.
   both(rig::testing::command_input(13));
