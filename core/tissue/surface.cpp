@@ -561,6 +561,7 @@ void Surface::apply_plasticity(double dt_s, double floor_mm, std::vector<std::ui
 void Surface::wake_all() {
   std::fill(block_awake_.begin(), block_awake_.end(), std::uint8_t{1});
   std::fill(block_quiet_steps_.begin(), block_quiet_steps_.end(), std::uint16_t{0});
+  ++awake_version_;
   note_all_blocks_moved();
 }
 
@@ -581,6 +582,7 @@ void Surface::update_sleep(std::span<const double> block_max_speed2, double slee
     }
     if (++block_quiet_steps_[b] < steps_to_sleep) continue;
     block_awake_[b] = 0;
+    ++awake_version_;
     const std::uint32_t end = std::min(vertex_slots(), (b + 1) * kSleepBlock);
     for (std::uint32_t v = b * kSleepBlock; v < end; ++v) v_[v] = Vec3::Zero();
   }

@@ -290,9 +290,14 @@ class Surface {
   // Waking does not move anything: what places a vertex (a new slot, set_position, a restore)
   // bumps block_motion itself.
   void wake_vertex(std::uint32_t v) {
-    block_awake_[v / kSleepBlock] = 1;
+    std::uint8_t& awake = block_awake_[v / kSleepBlock];
+    awake_version_ += awake == 0;
+    awake = 1;
     block_quiet_steps_[v / kSleepBlock] = 0;
   }
+  // Changes whenever a block wakes or falls asleep (or a snapshot replaces them all), so the
+  // solver knows when the awake region it laid out is still the same. Not part of the state.
+  std::uint64_t awake_version() const { return awake_version_; }
   void wake_all();
   // Motion bounds for spatial indexes (core/topology/vertex_index.hpp), in two parts:
   //  - block_motion(b) changes whenever b's vertices may have moved other than by the solver's
@@ -459,6 +464,7 @@ class Surface {
 
   // Sleeping.
   std::vector<std::uint8_t> block_awake_;
+  std::uint64_t awake_version_ = 0;
   std::vector<std::uint16_t> block_quiet_steps_;
   std::vector<std::uint32_t> block_motion_;  // see block_motion()
   std::vector<double> block_drift_mm_;       // see block_drift_mm()

@@ -68,6 +68,7 @@ void Surface::read_state(StateReader& in) {
   state_io(in);
   if (in.applying() && in.ok()) {
     note_all_blocks_moved();  // positions replaced: spatial indexes refit everything
+    ++awake_version_;         // awake blocks replaced: the solver lays them out again
     forget_spring_log();      // springs replaced: derived groups rebuild from every spring
   }
 }

@@ -94,6 +94,8 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.stencil_begin.resize(cap + 1);
   s.fill.resize(cap + 1);
   s.spring_terms.resize(2 * std::size_t{surface->edge_capacity()});
+  s.spring_edge.resize(s.spring_terms.size());
+  s.stencil_edge.resize(surface->edge_capacity());
   s.stencil_refs.resize(4 * std::size_t{surface->edge_capacity()});
   s.stencils.resize(surface->edge_capacity());
   s.target.resize(cap);

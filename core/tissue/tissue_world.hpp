@@ -260,6 +260,11 @@ class TissueWorld {
   const GlobeWall& wall() const { return wall_; }
   const Environment& environment() const { return environment_; }
   const SolverSettings& settings() const { return settings_; }
+  // For tests: lay the vertex sweep's terms out afresh every step instead of keeping the layout
+  // while the topology and the awake region stand (the results are the same, bit for bit).
+  void set_relayout_every_step(bool on) { relayout_every_step_ = on; }
+  // How many times a surface's layout was kept (its values refreshed) instead of rebuilt. Not state.
+  std::uint64_t layouts_kept() const { return layouts_kept_; }
   std::uint32_t attachment_count() const { return static_cast<std::uint32_t>(attachments_.size()); }
   bool attachment_intact(std::uint32_t i) const { return attachments_.at(i).intact; }
   // Intact and both ends still exist (a removed or cut-away end is only marked broken at the next step).
@@ -322,7 +327,7 @@ class TissueWorld {
     LocalForceDescription d;
   };
 
-  // ---- What the vertex sweep reads (built by pack_terms once per step; stage_solve.cpp) -------
+  // ---- What the vertex sweep reads (pack_terms, every step: laid out afresh or its values refreshed; stage_solve.cpp) -------
   // A spring as seen from one of its movable ends (each spring appears once per movable end).
   struct SpringTerm {
     std::uint32_t other;       // the vertex at the far end
@@ -403,7 +408,7 @@ class TissueWorld {
     std::vector<double> block_max_move2, block_step_drift_mm;
     // What a sleeping block's springs to awake vertices looked like when it fell asleep: each
     // block counts its sleeps, and a spring remembers its length for (block, count) — the first
-    // step it is packed with that block asleep (pack_springs). A sleeping block wakes when the
+    // step it is packed with that block asleep (pack_terms). A sleeping block wakes when the
     // length changes, not because it rests under tension (a detached retina always does).
     std::vector<std::uint32_t> block_sleep_serial;
     std::vector<std::uint64_t> wake_key;
@@ -423,6 +428,13 @@ class TissueWorld {
     std::vector<Stencil> stencils;
     std::uint32_t stencil_count = 0;
     std::vector<std::uint32_t> fill;  // scratch for the CSR fill
+    // The layout above (which vertices, which springs and stencils, where) depends only on the
+    // topology, the awake blocks and which of their vertices are movable; while none of them
+    // changes, pack_terms keeps it and refreshes the values from the springs and stencils they
+    // came from (spring_edge, stencil_edge: the spring of each term and stencil).
+    std::vector<std::uint32_t> spring_edge, stencil_edge;
+    bool layout_valid = false;
+    std::uint64_t layout_topology = 0, layout_awake = 0;
     std::vector<Vec3> target;         // the inertial target x̃ of the substep
     std::vector<std::uint32_t> point_head;  // per vertex: its first PointRef, or kNone
   };
@@ -437,6 +449,7 @@ class TissueWorld {
   void compute_external_accelerations(double h);
   void integrate_and_predict(double h);
   void pack_terms(double h);
+  bool refresh_packed_values(std::uint32_t si, double h);
   void add_point_terms(double fraction);
   void add_point_term(const PointTerm& term);
   void clear_point_terms();
@@ -462,6 +475,8 @@ class TissueWorld {
   GlobeWall wall_;
   Environment environment_;
   SolverSettings settings_;
+  bool relayout_every_step_ = false;
+  std::uint64_t layouts_kept_ = 0;
   std::vector<std::unique_ptr<Surface>> surfaces_;
   std::vector<std::unique_ptr<TopologyHook>> hooks_;  // per surface, may be null
   std::vector<Scratch> scratch_;

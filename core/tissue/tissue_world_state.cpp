@@ -65,6 +65,7 @@ void TissueWorld::state_io(IO& io) {
     io.fixed_vec(sc.block_sleep_serial);
     io.fixed_vec(sc.wake_key);
     io.fixed_vec(sc.wake_length);
+    sc.layout_valid = false;  // (reading or writing: a layout is rebuilt at the next step either way)
   }
 
   const std::size_t surfaces = surfaces_.size();

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/anatomy/retina_cap.hpp"
+#include "core/scene/snapshot.hpp"
 #include "core/tissue/surface_validity.hpp"
 #include "core/tissue/tissue_world.hpp"
 #include "test_meshes.hpp"
@@ -156,7 +157,7 @@ TEST(SolverBehaviour, TheRetinaNeverLeavesTheGlobe) {
   o.environment.intraocular_pressure_pa = units::mmhg_to_pa(60.0);  // far above normal
   o.detachment_pressure_pa = o.environment.intraocular_pressure_pa + 2000.0;
   auto scene = build_retina_cap(o);
-  for (int i = 0; i < 600; ++i) {
+  for (int i = 0; i < 300; ++i) {
     ASSERT_TRUE(scene.world.step(1e-3).ok);
     const Surface& s = scene.world.surface(scene.retina);
     for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
@@ -559,4 +560,37 @@ TEST(SolverBehaviour, ACutSeversTheStalksInItsReachAndNothingElse) {
   bad.surface_b = layers.lower;
   bad.rest_length_mm = -0.1;
   EXPECT_THROW(layers.world.add_attachment(bad), InvalidArgument);
+}
+
+// The vertex sweep's layout is kept from step to step while a surface's topology and awake region
+// stand, and only its values refreshed: the result must be the bits of a world that lays it out
+// afresh every step — through a breathing detachment (blocks waking and sleeping), torn springs and
+// a snapshot restored midway — and the layout must really have been kept most of the time.
+TEST(SolverBehaviour, KeepingTheSweepLayoutGivesTheBitsOfLayingItOutEveryStep) {
+  RetinaCapScene kept = build_retina_cap(small_retina()), fresh = build_retina_cap(small_retina());
+  fresh.world.set_relayout_every_step(true);
+  std::vector<std::uint8_t> midway;
+  for (int i = 0; i < 300; ++i) {
+    const double scale = 0.9 + 0.1 * std::sin(2.0 * 3.141592653589793 * 1e-3 * i);
+    for (RetinaCapScene* w : {&kept, &fresh}) {
+      ASSERT_TRUE(w->world.set_local_force_scale(w->detachment_force, scale));
+      if (i % 100 == 50) {  // a topology change: tear the interior spring of the lowest index
+        Surface& s = w->world.surface(w->retina);
+        std::uint32_t e = 0;
+        while (e < s.edge_slots() && !(s.edge_alive(e) && s.edge_triangles(e)[1] != kNone)) ++e;
+        ASSERT_LT(e, s.edge_slots());
+        const std::uint64_t before = s.topology_version();
+        (void)s.tear_edge(s.edge_id(e));
+        ASSERT_GT(s.topology_version(), before);
+      }
+      if (i == 150) {  // a snapshot taken and restored: the layout is laid out again after it
+        encode_snapshot(w->world, "midway", midway);
+        ASSERT_TRUE(decode_snapshot(w->world, midway));
+      }
+      ASSERT_TRUE(w->world.step(1e-3).ok);
+    }
+    ASSERT_EQ(kept.world.state_hash(), fresh.world.state_hash()) << "step " << i;
+  }
+  EXPECT_EQ(fresh.world.layouts_kept(), 0u);
+  EXPECT_GT(kept.world.layouts_kept(), 200u) << "the layout was kept on most of the 300 steps";
 }

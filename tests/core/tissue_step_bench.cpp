@@ -11,7 +11,9 @@
 //                 region (25° around polar 60°) stays awake, as tissue under an instrument does;
 //   2 all awake — sleeping off, the same breathing: every vertex simulated every step.
 // BM_TissueStepKnobs sweeps substeps and iterations at 20k, working: the stiffness-error-versus-
-// step-time curve of the solver's knobs.
+// step-time curve of the solver's knobs. BM_TissueStepRelayout is BM_TissueStep with the vertex
+// sweep's layout rebuilt every step (TissueWorld::set_relayout_every_step), as the solver did until
+// it kept the layout while the topology and the awake region stand: what keeping it saves.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -40,7 +42,7 @@ void report_quantiles(benchmark::State& state, std::vector<double>& samples_us, 
       benchmark::Counter(projections_per_step * static_cast<double>(samples_us.size()), benchmark::Counter::kIsRate);
 }
 
-void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, const SolverSettings& solver) {
+void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, const SolverSettings& solver, bool relayout = false) {
   RetinaCapOptions o;
   o.retina_vertices = vertices_wanted;
   o.membrane = true;
@@ -48,8 +50,10 @@ void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, co
   o.solver.sleeping = load != kAllAwake;
   auto scene = build_retina_cap(o);
   TissueWorld& world = scene.world;
+  world.set_relayout_every_step(relayout);
   // Warm-up: the detachment lifts and settles; the attached retina goes to sleep.
   for (int i = 0; i < 1000; ++i) world.step(1e-3);
+  const std::uint64_t kept_before = world.layouts_kept();
 
   std::size_t edges = 0, vertices = 0, bends = 0;
   for (std::uint32_t s = 0; s < world.surface_count(); ++s) {
@@ -84,6 +88,8 @@ void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, co
   state.counters["substeps"] = world.settings().substeps;
   state.counters["iterations"] = world.settings().iterations;
   state.counters["awake_fraction"] = step > 0 ? awake_sum / static_cast<double>(step) : 0.0;
+  // Surfaces whose sweep layout was kept (values refreshed, not laid out afresh), per step.
+  state.counters["layouts_kept_per_step"] = step > 0 ? static_cast<double>(world.layouts_kept() - kept_before) / static_cast<double>(step) : 0.0;
   report_quantiles(state, samples, projections_per_step);
   // The same retina's stiffness at the same settings (not timed): % off the nominal modulus.
   state.counters["stiffness_error_pct"] = 100.0 * vitreo::test::strip_stiffness_error(vertices_wanted, world.settings());
@@ -101,6 +107,11 @@ void BM_TissueStepKnobs(benchmark::State& state) {
   run_tissue_step(state, static_cast<int>(state.range(0)), kWorking, solver);
 }
 
+void BM_TissueStepRelayout(benchmark::State& state) {
+  SolverSettings solver;
+  run_tissue_step(state, static_cast<int>(state.range(0)), static_cast<Load>(state.range(1)), solver, true);
+}
+
 }  // namespace
 
 BENCHMARK(BM_TissueStep)
@@ -112,5 +123,11 @@ BENCHMARK(BM_TissueStep)
 BENCHMARK(BM_TissueStepKnobs)
     ->ArgNames({"vertices", "substeps", "iterations"})
     ->ArgsProduct({{20000}, {1, 2, 4}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->MinTime(2.0);
+
+BENCHMARK(BM_TissueStepRelayout)
+    ->ArgNames({"vertices", "load"})
+    ->ArgsProduct({{20000}, {kWorking, kAllAwake}})
     ->Unit(benchmark::kMicrosecond)
     ->MinTime(2.0);
