@@ -66,6 +66,11 @@ const std::vector<std::string>& known_instruments() {
   return names;
 }
 
+const std::vector<std::string>& second_hand_instruments() {
+  static const std::vector<std::string> names{"light_pipe", "forceps", "pick", "scissors"};
+  return names;
+}
+
 SceneMaterials default_materials() {
   SceneMaterials m;
   m.retina = TissueMaterial{};
@@ -174,7 +179,8 @@ void SceneDescription::validate() const {
   if (working_port != "working_1" && working_port != "working_2") {
     throw InvalidArgument("instruments.working_port '" + working_port + "' is not a working port (working_1, working_2)");
   }
-  if (second_hand != "light_pipe" && second_hand != "forceps" && second_hand != "pick" && second_hand != "scissors") {
+  const auto& holdable = second_hand_instruments();
+  if (std::find(holdable.begin(), holdable.end(), second_hand) == holdable.end()) {
     throw InvalidArgument("instruments.second_hand '" + second_hand + "' is not one the other hand holds (light_pipe, forceps, pick, scissors)");
   }
   if (second_hand != "light_pipe") {

@@ -193,6 +193,9 @@ const char* to_string(CriterionKind k);
 const char* to_string(GelStain s);
 // Names accepted for instruments.
 const std::vector<std::string>& known_instruments();
+// What the other hand may hold (SceneDescription::second_hand): the light pipe, or a tool its own
+// handle works.
+const std::vector<std::string>& second_hand_instruments();
 
 // Default materials with their sources (the values the scene files start from).
 SceneMaterials default_materials();

@@ -70,8 +70,8 @@ void add_diagonal(std::array<double, 6>& m, double s) {
 // its springs (from the active spring groups, which hold every spring touching an awake block) and
 // its bending stencils, laid out contiguously so the sweep streams through them. The layout stands
 // while the surface's topology, its awake blocks and its movable vertices do: then only the values
-// are refreshed (refresh_packed_values), the same bits as a fresh layout (measured in
-// core/tissue/MEASUREMENTS.md, 2026-11-28: a 20k step 16 % faster with every vertex awake).
+// are refreshed (refresh_packed_values), the same bits as a fresh layout, in less time
+// (core/tissue/MEASUREMENTS.md, 2026-11-28).
 void TissueWorld::pack_terms(double h) {
   for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     Surface& s = *surfaces_[si];

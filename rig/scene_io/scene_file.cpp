@@ -392,7 +392,8 @@ core::SceneDescription parse_scene(std::string_view text, const std::string& fil
     t->string("working_port", d.working_port);
     if (d.working_port != "working_1" && d.working_port != "working_2") t->fail("working_port", "expected \"working_1\" or \"working_2\"");
     t->string("second_hand", d.second_hand);
-    if (d.second_hand != "light_pipe" && d.second_hand != "forceps" && d.second_hand != "pick" && d.second_hand != "scissors")
+    const auto& holdable = core::second_hand_instruments();
+    if (std::find(holdable.begin(), holdable.end(), d.second_hand) == holdable.end())
       t->fail("second_hand", "expected \"light_pipe\", \"forceps\", \"pick\" or \"scissors\"");
     t->finish();
     const auto& known = core::known_instruments();
