@@ -21,6 +21,8 @@ packages=(
   zlib1g-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the solver benchmark times Bullet's btSoftBody beside vitreo's step (tests/core/bullet_softbody_bench.cpp)
+  libbullet-dev
   umockdev libumockdev-dev can-utils iproute2 util-linux
   # the install tests: systemd-analyze, -sysusers, -tmpfiles check the unit and snippets; udevadm
   # runs the udev rules; strace lists the system calls the unit's sandbox must allow

@@ -65,6 +65,46 @@ TriangleMesh retina_strip(int retina_vertices, double width_mm, double length_mm
   return m;
 }
 
+StripLoad strip_load(const TriangleMesh& mesh, double sigma) {
+  StripLoad l;
+  double y0 = 1e9, y1 = -1e9;
+  l.x0 = 1e9, l.x1 = -1e9;
+  for (const auto& p : mesh.positions) {
+    l.x0 = std::min(l.x0, p.x()), l.x1 = std::max(l.x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
+  }
+  for (const auto& t : mesh.triangles)
+    for (std::size_t k = 0; k < 3; ++k) l.longest_edge = std::max(l.longest_edge, (mesh.positions[t[k]] - mesh.positions[t[(k + 1) % 3]]).norm());
+  l.width = y1 - y0;
+  l.y_mid = 0.5 * (y0 + y1);
+  for (std::uint32_t v = 0; v < mesh.positions.size(); ++v) {
+    if (mesh.positions[v].x() < l.x0 + 0.3 * l.longest_edge) l.clamped.push_back(v);
+    if (mesh.positions[v].x() > l.x1 - 0.3 * l.longest_edge) l.pulled.push_back(v);
+  }
+  const auto& x = mesh.positions;
+  std::sort(l.pulled.begin(), l.pulled.end(), [&](auto a, auto b) { return x[a].y() < x[b].y(); });
+  for (std::size_t i = 0; i < l.pulled.size(); ++i) {
+    const double lo = i == 0 ? y0 : 0.5 * (x[l.pulled[i - 1]].y() + x[l.pulled[i]].y());
+    const double hi = i + 1 == l.pulled.size() ? y1 : 0.5 * (x[l.pulled[i]].y() + x[l.pulled[i + 1]].y());
+    l.force_un.push_back(sigma * (hi - lo));
+  }
+  return l;
+}
+
+double strip_strain(const TriangleMesh& mesh, const StripLoad& load, const std::function<Vec3(std::uint32_t)>& position) {
+  auto mean_x = [&](double at) {
+    double now = 0.0, rest = 0.0;
+    int n = 0;
+    for (std::uint32_t v = 0; v < mesh.positions.size(); ++v) {
+      if (std::abs(mesh.positions[v].x() - at) > 0.6 * load.longest_edge) continue;
+      now += position(v).x(), rest += mesh.positions[v].x(), ++n;
+    }
+    return std::pair{now / n, rest / n};
+  };
+  const auto [a_now, a_rest] = mean_x(load.x0 + (load.x1 - load.x0) / 3);
+  const auto [b_now, b_rest] = mean_x(load.x0 + 2 * (load.x1 - load.x0) / 3);
+  return ((b_now - a_now) - (b_rest - a_rest)) / (b_rest - a_rest);
+}
+
 StripResult stretch_strip(const TriangleMesh& mesh, const TissueMaterial& material, double strain_target,
                           const SolverSettings& settings, double max_settle_s) {
   SurfaceDescription d;
@@ -77,32 +117,20 @@ StripResult stretch_strip(const TriangleMesh& mesh, const TissueMaterial& materi
   Surface& s = world.surface(id);
   StripResult r;
   r.vertices = mesh.positions.size();
-  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9, edge = 0.0;
-  for (const auto& p : mesh.positions) {
-    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
-  }
-  for (std::uint32_t e = 0; e < s.edge_slots(); ++e) edge = std::max(edge, s.edge_rest_length(e));
-  const double width = y1 - y0, sigma = strain_target * material.membrane_modulus_pa_mm;
-  std::vector<std::uint32_t> pulled;
-  for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-    if (s.rest_position(v).x() < x0 + 0.3 * edge) r.clamped = r.clamped && s.set_fixed(s.vertex_id(v), true).is_ok();
-    if (s.rest_position(v).x() > x1 - 0.3 * edge) pulled.push_back(v);
-  }
-  std::sort(pulled.begin(), pulled.end(), [&](auto a, auto b) { return s.rest_position(a).y() < s.rest_position(b).y(); });
+  const double sigma = strain_target * material.membrane_modulus_pa_mm;
+  const StripLoad load = strip_load(mesh, sigma);
+  for (const auto v : load.clamped) r.clamped = r.clamped && s.set_fixed(s.vertex_id(v), true).is_ok();
   LocalForceDescription f;
   f.name = "pull";
   f.surface = id;
-  f.toward_point_mm = Vec3(1e9, 0.5 * (y0 + y1), 0.0);
+  f.toward_point_mm = Vec3(1e9, load.y_mid, 0.0);
   f.pressure_pa = 1e5;
-  for (std::size_t i = 0; i < pulled.size(); ++i) {
-    const double lo = i == 0 ? y0 : 0.5 * (s.rest_position(pulled[i - 1]).y() + s.rest_position(pulled[i]).y());
-    const double hi = i + 1 == pulled.size() ? y1 : 0.5 * (s.rest_position(pulled[i]).y() + s.rest_position(pulled[i + 1]).y());
-    const double force = sigma * (hi - lo);
-    r.applied_force_un += force;
-    f.vertices.push_back(pulled[i]);
-    f.weights.push_back(force / (f.pressure_pa * s.vertex_rest_area(pulled[i])));
+  for (std::size_t i = 0; i < load.pulled.size(); ++i) {
+    r.applied_force_un += load.force_un[i];
+    f.vertices.push_back(load.pulled[i]);
+    f.weights.push_back(load.force_un[i] / (f.pressure_pa * s.vertex_rest_area(load.pulled[i])));
   }
-  r.expected_force_un = sigma * width;
+  r.expected_force_un = sigma * load.width;
   world.add_local_force(f);
 
   int i = 0;
@@ -111,19 +139,7 @@ StripResult stretch_strip(const TriangleMesh& mesh, const TissueMaterial& materi
     if (world.awake_blocks() == 0) break;
   }
   r.settle_s = i * kDt;
-  auto mean_x = [&](double at) {
-    double now = 0.0, rest = 0.0;
-    int n = 0;
-    for (std::uint32_t v = 0; v < s.vertex_slots(); ++v) {
-      if (std::abs(s.rest_position(v).x() - at) > 0.6 * edge) continue;
-      now += s.position(v).x(), rest += s.rest_position(v).x(), ++n;
-    }
-    return std::pair{now / n, rest / n};
-  };
-  const auto [a_now, a_rest] = mean_x(x0 + (x1 - x0) / 3);
-  const auto [b_now, b_rest] = mean_x(x0 + 2 * (x1 - x0) / 3);
-  const double strain = ((b_now - a_now) - (b_rest - a_rest)) / (b_rest - a_rest);
-  r.modulus = sigma / strain;
+  r.modulus = sigma / strip_strain(mesh, load, [&](std::uint32_t v) { return s.position(v); });
   return r;
 }
 

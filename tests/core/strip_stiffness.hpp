@@ -6,6 +6,9 @@
 // at the rig's settings, and the solver benchmark, which reports it as a counter beside the step
 // time so speed can never be bought with softness.
 #include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "core/geometry/triangle_mesh.hpp"
 #include "core/tissue/material.hpp"
@@ -22,6 +25,19 @@ core::Environment weightless();
 // and L long around the axis, laid flat (x along the azimuth, y across the rings). Near the
 // equator the rings barely change radius, so the triangles keep their shape.
 core::TriangleMesh retina_strip(int retina_vertices, double width_mm, double length_mm);
+
+// The strip's load case, whatever solver carries it: the vertices clamped (within 0.3 of the longest
+// edge of the left end), those pulled (the same at the right end, sorted across the strip) with the
+// force each takes (σ × its share of the width, µN, along +x), and where the strain is read.
+struct StripLoad {
+  std::vector<std::uint32_t> clamped, pulled;
+  std::vector<double> force_un;
+  double x0 = 0.0, x1 = 0.0, width = 0.0, y_mid = 0.0, longest_edge = 0.0;
+};
+StripLoad strip_load(const core::TriangleMesh& mesh, double sigma);
+// The strain between the material lines at a third and two thirds of the strip's length (mean x of
+// the vertices within 0.6 edge of each), from the solver's positions of the mesh's vertices.
+double strip_strain(const core::TriangleMesh& mesh, const StripLoad& load, const std::function<core::Vec3(std::uint32_t)>& position);
 
 struct StripResult {
   double modulus = 0.0;        // traction / strain, µN/mm
