@@ -67,7 +67,9 @@ Played play(const std::string& case_name, const fs::path& script_file, const std
   Played out;
   out.script = read_surgical_script(script_file.string());
   if (tremor_mm >= 0.0) out.script.tremor_mm = tremor_mm;
-  const fs::path dir = fs::path(::testing::TempDir()) / ("scripted-" + case_name + "-" + tag);
+  // The resolution in the folder's name: the rig's and the case's own runs of a script may play at once.
+  const std::string resolution = retina_vertices == kCaseOwnVertices ? "own" : std::to_string(retina_vertices);
+  const fs::path dir = fs::path(::testing::TempDir()) / ("scripted-" + case_name + "-" + tag + "-" + resolution);
   fs::remove_all(dir);
   fs::create_directories(dir);
   SessionConfig config;
