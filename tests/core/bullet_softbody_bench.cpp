@@ -87,9 +87,9 @@ struct BulletBody {
 // The strip of strip_stiffness.hpp (the same load case: strip_load, strip_strain) in Bullet, its
 // masses lumped from the retina's density and thickness as vitreo's; read once settled (every node
 // slower than 1 µm/s, or 10 s). Returns the modulus's error (−0.1: 10 % too soft).
-double bullet_strip_error(double klst, int piterations) {
+double bullet_strip_error(int retina_vertices, double klst, int piterations) {
   const TissueMaterial retina;
-  const TriangleMesh m = vitreo::test::retina_strip(20000, 2.0, 8.0);
+  const TriangleMesh m = vitreo::test::retina_strip(retina_vertices, 2.0, 8.0);
   const double rho_area = retina.density_g_per_mm3 * retina.thickness_mm;
   std::vector<double> mass(m.positions.size(), 0.0);
   std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
@@ -105,7 +105,7 @@ double bullet_strip_error(double klst, int piterations) {
   for (const auto v : load.clamped) mass[v] = 0.0;  // clamped: Bullet's static node
   BulletBody b(m.positions, mass, Vec3::Zero());
   for (const auto& [a, c] : edges) b.link(static_cast<int>(a), static_cast<int>(c));
-  b.configure(klst, piterations, 0.05);
+  b.configure(klst, piterations, 0.05);  // a little damping, so that the strip comes to rest (vitreo's settles under its drag)
   for (int i = 0; i < 10000; ++i) {
     b.step([&] {
       for (std::size_t k = 0; k < load.pulled.size(); ++k) b.body->addForce(btVector3(load.force_un[k], 0, 0), static_cast<int>(load.pulled[k]));
@@ -121,15 +121,15 @@ double bullet_strip_error(double klst, int piterations) {
   return (sigma / strain) / retina.membrane_modulus_pa_mm - 1.0;
 }
 
-// The kLST whose strip error is closest to `target` (the error falls as kLST grows: softer links).
-std::pair<double, double> klst_for_error(double target, int piterations) {
+// The kLST whose strip error is closest to `target` (the error grows with kLST: stiffer links).
+std::pair<double, double> klst_for_error(int retina_vertices, double target, int piterations) {
   double lo = 1e-5, hi = 1.0;
-  double e_hi = bullet_strip_error(hi, piterations);
+  double e_hi = bullet_strip_error(retina_vertices, hi, piterations);
   if (e_hi < target) return {hi, e_hi};  // even rigid-as-it-gets links are softer than vitreo's
   double best = hi, best_e = e_hi;
   for (int i = 0; i < 14; ++i) {
     const double mid = std::sqrt(lo * hi);
-    const double e = bullet_strip_error(mid, piterations);
+    const double e = bullet_strip_error(retina_vertices, mid, piterations);
     if (std::abs(e - target) < std::abs(best_e - target)) best = mid, best_e = e;
     if (e > target) {
       hi = mid;
@@ -145,7 +145,7 @@ void BM_BulletSoftBodyStep(benchmark::State& state) {
   const int piterations = static_cast<int>(state.range(1));
   SolverSettings rig;  // vitreo's error at the rig's settings, the target
   const double vitreo_error = vitreo::test::strip_stiffness_error(vertices_wanted, rig);
-  const auto [klst, bullet_error] = klst_for_error(vitreo_error, piterations);
+  const auto [klst, bullet_error] = klst_for_error(vertices_wanted, vitreo_error, piterations);
 
   RetinaCapOptions o;
   o.retina_vertices = vertices_wanted;
@@ -194,19 +194,19 @@ void BM_BulletSoftBodyStep(benchmark::State& state) {
   // The detachment: pressure × area × weight toward its point, breathing ±10 % at 1 Hz.
   const LocalForceDescription& f = world.local_force(scene.detachment_force);
   const Surface& fs = world.surface(f.surface);
-  std::vector<std::pair<int, Vec3>> push;  // node, force at scale 1 (its direction from the rest shape)
+  std::vector<std::pair<int, double>> push;  // node, force at scale 1 (µN; toward the point from where the node is)
   for (std::size_t i = 0; i < f.vertices.size(); ++i) {
     const std::uint32_t v = f.vertices[i];
     const double w = f.weights.empty() ? 1.0 : f.weights[i];
-    push.push_back({static_cast<int>(base[f.surface] + v), f.pressure_pa * fs.vertex_rest_area(v) * w * (f.toward_point_mm - fs.rest_position(v)).normalized()});
+    push.push_back({static_cast<int>(base[f.surface] + v), f.pressure_pa * fs.vertex_rest_area(v) * w});
   }
   std::uint64_t step = 0;
   auto forces = [&] {
     const double scale = 0.9 + 0.1 * std::sin(2.0 * std::numbers::pi * kDt * static_cast<double>(step));
-    for (const auto& [node, fv] : push) {
+    for (const auto& [node, force_un] : push) {
       const btVector3& p = b.body->m_nodes[node].m_x;
       const Vec3 dir = (f.toward_point_mm - Vec3(p.x(), p.y(), p.z())).normalized();
-      b.body->addForce(bt(scale * fv.norm() * dir), node);
+      b.body->addForce(bt(scale * force_un * dir), node);
     }
   };
   for (int i = 0; i < 200; ++i, ++step) b.step(forces);  // warm-up (BM_TissueStep's is 1000 steps: Bullet's are slower)
