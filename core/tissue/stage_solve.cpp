@@ -176,12 +176,16 @@ void TissueWorld::pack_terms(double h) {
     sc.layout_valid = true;
     sc.layout_topology = s.topology_version();
     sc.layout_awake = s.awake_version();
+    sc.layout_spring_values = s.spring_values_version();
+    sc.layout_damping_per_k = damping_per_k;
   }
 }
 
-// The same layout as the last step's: each spring term and stencil takes its values afresh from
-// its spring, exactly as a full pack would (the wake fields stand: no block woke or slept). False
-// when a stencil's spring has lost its bending, which a full pack would leave out.
+// The same layout as the last step's: each stencil and, where any spring's rest length or stiffness
+// changed since they were filled (Surface::spring_values_version), each spring term takes its values
+// afresh from its spring, exactly as a full pack would (the wake fields stand: no block woke or
+// slept). Stencils always do: their target follows the stencil's current normal. False when a
+// stencil's spring has lost its bending, which a full pack would leave out.
 bool TissueWorld::refresh_packed_values(std::uint32_t si, double h) {
   Surface& s = *surfaces_[si];
   Scratch& sc = scratch_[si];
@@ -200,6 +204,9 @@ bool TissueWorld::refresh_packed_values(std::uint32_t si, double h) {
     out.k = st.stiffness;
     out.target = view.bend_rest[e] * st.normal(x[out.v[0]], x[out.v[1]], x[out.v[2]], x[out.v[3]]);
   }
+  if (sc.layout_spring_values == s.spring_values_version() && sc.layout_damping_per_k == damping_per_k) return true;
+  sc.layout_spring_values = s.spring_values_version();
+  sc.layout_damping_per_k = damping_per_k;
   const std::uint32_t terms = sc.spring_begin[sc.active_count];
   for (std::uint32_t i = 0; i < terms; ++i) {
     const std::uint32_t e = sc.spring_edge[i];

@@ -107,6 +107,7 @@ Surface::Surface(const SurfaceDescription& d)
     edge_is_line_[e] = 1;
     ++line_springs_;
     stiffness_[e] = ls.stiffness_un_per_mm;
+    ++spring_values_version_;
   }
   // find_edge for line springs walks triangle fans, so it does not see them; line springs are
   // kept in a separate per-vertex search only at build time, which is all they need.
@@ -216,6 +217,7 @@ void Surface::free_edge(std::uint32_t e) {
   edge_alive_[e] = 0;
   log_spring(e);
   stiffness_[e] = 0.0;
+  ++spring_values_version_;
   bend_[e] = BendStencil{};
   ++edge_generation_[e];
   free_edges_.push_back(e);
@@ -327,6 +329,7 @@ void Surface::refresh_noted() {
 }
 
 void Surface::refresh_rest(std::uint32_t e) {
+  ++spring_values_version_;
   rest_vec_[e] = base_rest_vec_[e] * (surface_traction_ * edge_traction_[e]);
   rest_len_[e] = rest_vec_[e].norm();
 }
@@ -348,6 +351,7 @@ void Surface::update_edge_stiffness(std::uint32_t e) {
     if (t != kNone && len2 > 0.0) k += triangle_spring_share(t, e) / len2;
   }
   stiffness_[e] = k;
+  ++spring_values_version_;
   update_edge_bending(e);
 }
 

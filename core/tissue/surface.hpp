@@ -321,6 +321,10 @@ class Surface {
   std::uint32_t awake_block_count() const;
   // Incremented by every topology change, so solver-side indexes know when to rebuild.
   std::uint64_t topology_version() const { return topology_version_; }
+  // Changes whenever a spring's rest length or stiffness may have changed (creep, traction, a
+  // stiffness recomputed, a snapshot restored), so the solver knows when the values it copied
+  // into its sweep layout still stand. Not part of the state.
+  std::uint64_t spring_values_version() const { return spring_values_version_; }
 
   // ---- Spring log ------------------------------------------------------------------------------
   // Every spring added, removed or moved to another vertex is logged by its slot (a slot may
@@ -469,6 +473,7 @@ class Surface {
   std::vector<std::uint32_t> block_motion_;  // see block_motion()
   std::vector<double> block_drift_mm_;       // see block_drift_mm()
   std::uint64_t topology_version_ = 0;
+  std::uint64_t spring_values_version_ = 0;  // see spring_values_version()
   std::uint32_t line_springs_ = 0;
 
   // Batched edits (see EditBatch): flags and lists of the noted vertices and springs.

@@ -70,6 +70,7 @@ void Surface::read_state(StateReader& in) {
     note_all_blocks_moved();  // positions replaced: spatial indexes refit everything
     ++awake_version_;         // awake blocks replaced: the solver lays them out again
     forget_spring_log();      // springs replaced: derived groups rebuild from every spring
+    ++spring_values_version_;  // and their rest lengths and stiffnesses
   }
 }
 

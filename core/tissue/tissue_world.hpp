@@ -435,6 +435,9 @@ class TissueWorld {
     std::vector<std::uint32_t> spring_edge, stencil_edge;
     bool layout_valid = false;
     std::uint64_t layout_topology = 0, layout_awake = 0;
+    // The surface's spring values and the dashpot factor the spring terms were last filled from.
+    std::uint64_t layout_spring_values = 0;
+    double layout_damping_per_k = 0.0;
     std::vector<Vec3> target;         // the inertial target x̃ of the substep
     std::vector<std::uint32_t> point_head;  // per vertex: its first PointRef, or kNone
   };

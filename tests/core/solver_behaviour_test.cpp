@@ -564,8 +564,9 @@ TEST(SolverBehaviour, ACutSeversTheStalksInItsReachAndNothingElse) {
 
 // The vertex sweep's layout is kept from step to step while a surface's topology and awake region
 // stand, and only its values refreshed: the result must be the bits of a world that lays it out
-// afresh every step — through a breathing detachment (blocks waking and sleeping), torn springs and
-// a snapshot restored midway — and the layout must really have been kept most of the time.
+// afresh every step — through a breathing detachment (blocks waking and sleeping), torn springs, a
+// spring's rest length changed in place and a snapshot restored midway — and the layout must really
+// have been kept most of the time.
 TEST(SolverBehaviour, KeepingTheSweepLayoutGivesTheBitsOfLayingItOutEveryStep) {
   RetinaCapScene kept = build_retina_cap(small_retina()), fresh = build_retina_cap(small_retina());
   fresh.world.set_relayout_every_step(true);
@@ -582,6 +583,16 @@ TEST(SolverBehaviour, KeepingTheSweepLayoutGivesTheBitsOfLayingItOutEveryStep) {
         const std::uint64_t before = s.topology_version();
         (void)s.tear_edge(s.edge_id(e));
         ASSERT_GT(s.topology_version(), before);
+      }
+      if (i % 100 == 80) {  // a rest length changed in place (as creep and traction do): same layout, new values
+        Surface& s = w->world.surface(w->retina);
+        std::uint32_t e = 0;
+        while (e < s.edge_slots() && !(s.edge_alive(e) && s.vertex_awake(s.edge_vertices(e)[0]) && s.vertex_awake(s.edge_vertices(e)[1]))) ++e;
+        ASSERT_LT(e, s.edge_slots());
+        const std::uint64_t awake_before = s.awake_version(), values_before = s.spring_values_version();
+        ASSERT_TRUE(s.set_edge_traction(s.edge_id(e), 0.9));
+        ASSERT_EQ(s.awake_version(), awake_before) << "the layout stands";
+        ASSERT_GT(s.spring_values_version(), values_before);
       }
       if (i == 150) {  // a snapshot taken and restored: the layout is laid out again after it
         encode_snapshot(w->world, "midway", midway);
