@@ -18,7 +18,7 @@ constexpr double kContactBand_mm = 1e-3;
 
 void TissueWorld::compute_external_accelerations(double h) {
   const Environment& env = environment_;
-  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     Surface& s = *surfaces_[si];
     Scratch& sc = scratch_[si];
     auto view = s.solver_view();
@@ -47,7 +47,7 @@ void TissueWorld::compute_external_accelerations(double h) {
     }
 
     // Forces first (µN), converted to accelerations at the end.
-    for_each_awake_vertex(s, [&](std::uint32_t v) { sc.acceleration[v] = Vec3::Zero(); });
+    for_awake_vertices(si, [&](std::uint32_t v) { sc.acceleration[v] = Vec3::Zero(); });
 
     // Intraocular pressure presses the retina outward onto the choroid. It is applied along the
     // ray from the globe centre, on each vertex's share of the current (stretched) area: directed
@@ -89,7 +89,7 @@ void TissueWorld::compute_external_accelerations(double h) {
     // cosine of the angle off the port axis, capped like the thesis' clamp on small new vertices.
     for (const SuctionField& f : suction_) {
       const double r2 = f.radius_mm * f.radius_mm;
-      for_each_awake_vertex(s, [&](std::uint32_t v) {
+      for_awake_vertices(si, [&](std::uint32_t v) {
         if (!view.vertex_alive[v] || view.inverse_mass[v] == 0.0) return;
         const Vec3 out = view.x[v] - f.apex_mm;
         const double d2 = out.squaredNorm();
@@ -105,7 +105,7 @@ void TissueWorld::compute_external_accelerations(double h) {
     const bool walled = s.contained_by_globe();
     const double added_per_area = env.fluid_density_g_per_mm3 * s.material().entrained_fluid_mm;
     const double mu = settings_.wall_friction;
-    for_each_awake_vertex(s, [&](std::uint32_t v) {
+    for_awake_vertices(si, [&](std::uint32_t v) {
       if (!view.vertex_alive[v] || view.inverse_mass[v] == 0.0) {
         sc.acceleration[v] = Vec3::Zero();
         sc.effective_inverse_mass[v] = 0.0;

@@ -20,6 +20,7 @@
 // weight through the whole mesh settles where the tissue has sagged enough to balance one partial
 // sweep: tens of times softer than the material on a 20k retina at two substeps.)
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "core/tissue/awake_vertices.hpp"
@@ -192,30 +193,38 @@ bool TissueWorld::refresh_packed_values(std::uint32_t si, double h) {
   auto view = s.solver_view();
   const Vec3* x = view.x.data();
   const double damping_per_k = s.material().internal_damping_s / h;
-  for (std::uint32_t i = 0; i < sc.stencil_count; ++i) {
-    const std::uint32_t e = sc.stencil_edge[i];
-    const Surface::BendStencil& st = view.bend[e];
-    if (st.stiffness == 0.0) {
-      sc.layout_valid = false;
-      return false;
+  std::atomic<bool> bending_kept{true};
+  run_sliced(workers_.get(), sc.stencil_count, [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const std::uint32_t e = sc.stencil_edge[i];
+      const Surface::BendStencil& st = view.bend[e];
+      if (st.stiffness == 0.0) {
+        bending_kept.store(false, std::memory_order_relaxed);
+        return;
+      }
+      Stencil& out = sc.stencils[i];
+      out.K = st.K;
+      out.k = st.stiffness;
+      out.target = view.bend_rest[e] * st.normal(x[out.v[0]], x[out.v[1]], x[out.v[2]], x[out.v[3]]);
     }
-    Stencil& out = sc.stencils[i];
-    out.K = st.K;
-    out.k = st.stiffness;
-    out.target = view.bend_rest[e] * st.normal(x[out.v[0]], x[out.v[1]], x[out.v[2]], x[out.v[3]]);
+  });
+  if (!bending_kept.load(std::memory_order_relaxed)) {
+    sc.layout_valid = false;
+    return false;
   }
   if (sc.layout_spring_values == s.spring_values_version() && sc.layout_damping_per_k == damping_per_k) return true;
   sc.layout_spring_values = s.spring_values_version();
   sc.layout_damping_per_k = damping_per_k;
-  const std::uint32_t terms = sc.spring_begin[sc.active_count];
-  for (std::uint32_t i = 0; i < terms; ++i) {
-    const std::uint32_t e = sc.spring_edge[i];
-    SpringTerm& t = sc.spring_terms[i];
-    const double k = view.stiffness[e];
-    t.k = k;
-    t.rest_len = view.rest_len[e];
-    t.damping = k * damping_per_k;
-  }
+  run_sliced(workers_.get(), sc.spring_begin[sc.active_count], [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const std::uint32_t e = sc.spring_edge[i];
+      SpringTerm& t = sc.spring_terms[i];
+      const double k = view.stiffness[e];
+      t.k = k;
+      t.rest_len = view.rest_len[e];
+      t.damping = k * damping_per_k;
+    }
+  });
   return true;
 }
 
@@ -224,10 +233,12 @@ void TissueWorld::begin_sweep() {
   for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     Scratch& sc = scratch_[si];
     const Vec3* x = surfaces_[si]->solver_view().x.data();
-    for (std::uint32_t i = 0; i < sc.stencil_count; ++i) {
-      Stencil& st = sc.stencils[i];
-      st.h = st.K[0] * x[st.v[0]] + st.K[1] * x[st.v[1]] + st.K[2] * x[st.v[2]] + st.K[3] * x[st.v[3]];
-    }
+    run_sliced(workers_.get(), sc.stencil_count, [&](std::uint32_t begin, std::uint32_t end) {
+      for (std::uint32_t i = begin; i < end; ++i) {
+        Stencil& st = sc.stencils[i];
+        st.h = st.K[0] * x[st.v[0]] + st.K[1] * x[st.v[1]] + st.K[2] * x[st.v[2]] + st.K[3] * x[st.v[3]];
+      }
+    });
   }
 }
 

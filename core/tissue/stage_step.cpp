@@ -1,6 +1,7 @@
 // The step pipeline: validate → save rollback → forces → substeps (predict, project, velocities) →
 // step-boundary changes (broken attachments, tears) → events.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -19,10 +20,10 @@ constexpr double kMinTearRest_mm = 0.01;
 // Only awake vertices can change during a step (sleeping ones are skipped, and wake-ups are applied
 // at its end), so only they need saving.
 void TissueWorld::save_rollback() {
-  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
-    for_each_awake_vertex(*surfaces_[si], [&](std::uint32_t v) {
+    for_awake_vertices(si, [&](std::uint32_t v) {
       sc.rollback_x[v] = view.x[v];
       sc.rollback_v[v] = view.v[v];
     });
@@ -43,12 +44,12 @@ void TissueWorld::restore_rollback() {
 void TissueWorld::integrate_and_predict(double h) {
   const double offset = settings_.wall_offset_mm;
   const double settle_keep = 1.0 / (1.0 + h * settings_.settling_damping_per_s);
-  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     const Surface& s = *surfaces_[si];
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
     const bool walled = s.contained_by_globe();
-    for_each_awake_vertex(s, [&](std::uint32_t v) {
+    for_awake_vertices(si, [&](std::uint32_t v) {
       sc.previous[v] = view.x[v];
       if (view.inverse_mass[v] == 0.0) return;
       if (sc.contact_load[v] > 0.0) {
@@ -101,48 +102,64 @@ void TissueWorld::integrate_and_predict(double h) {
 
 bool TissueWorld::update_velocities(double h) {
   const double inv_h = 1.0 / h;
-  double checksum = 0.0;  // NaN or infinity anywhere propagates into the sum
-  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+  // A NaN or infinity anywhere propagates into its block's sum. Summed per block, not over the
+  // surface, so the check does not depend on how the blocks are split over threads.
+  std::atomic<bool> finite{true};
+  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
     const Surface& s = *surfaces_[si];
     auto view = surfaces_[si]->solver_view();
     Scratch& sc = scratch_[si];
     std::fill(sc.block_max_speed2.begin(), sc.block_max_speed2.end(), 0.0);
     std::fill(sc.block_max_move2.begin(), sc.block_max_move2.end(), 0.0);
-    for_each_awake_vertex(s, [&](std::uint32_t v) {
-      const Vec3 moved = view.x[v] - sc.previous[v];
-      double& move2 = sc.block_max_move2[v / Surface::kSleepBlock];  // kinematic vertices move too
-      move2 = std::max(move2, moved.squaredNorm());
-      if (view.inverse_mass[v] == 0.0) return;
-      // Keep the momentum in the next start only while it helps (adaptive restart, O'Donoghue &
-      // Candès 2015, per vertex): where the sweeps carried the vertex at least as far along its
-      // last velocity as the drag alone would, the motion is real; where they pulled it back, the
-      // continued motion overshot, and an overshoot left in would feed an oscillation of the
-      // unconverged sweeps (stiff slivers after a cut shake themselves apart without this).
-      const Vec3& last = view.v[v];
-      if (sc.momentum[v] == Scratch::kStartCarried && moved.dot(last) < h * sc.velocity_keep[v] * last.squaredNorm()) {
-        sc.momentum[v] = Scratch::kStartDamped;
+    for_awake_blocks(si, [&](std::uint32_t block, std::uint32_t first, std::uint32_t end) {
+      double checksum = 0.0;
+      double max_move2 = 0.0;  // kinematic vertices move too
+      double max_speed2 = 0.0;
+      for (std::uint32_t v = first; v < end; ++v) {
+        const Vec3 moved = view.x[v] - sc.previous[v];
+        max_move2 = std::max(max_move2, moved.squaredNorm());
+        if (view.inverse_mass[v] == 0.0) continue;
+        // Keep the momentum in the next start only while it helps (adaptive restart, O'Donoghue &
+        // Candès 2015, per vertex): where the sweeps carried the vertex at least as far along its
+        // last velocity as the drag alone would, the motion is real; where they pulled it back, the
+        // continued motion overshot, and an overshoot left in would feed an oscillation of the
+        // unconverged sweeps (stiff slivers after a cut shake themselves apart without this).
+        const Vec3& last = view.v[v];
+        if (sc.momentum[v] == Scratch::kStartCarried && moved.dot(last) < h * sc.velocity_keep[v] * last.squaredNorm()) {
+          sc.momentum[v] = Scratch::kStartDamped;
+        }
+        view.v[v] = moved * inv_h;
+        if (sc.wall_touched[v]) {
+          sc.wall_touched[v] = 0;
+          const Vec3 radial = view.x[v] - wall_.center();
+          const Vec3 normal = radial * (1.0 / radial.norm());  // touched: on the wall, never at the centre
+          const double vn = view.v[v].dot(normal);
+          if (vn > 0.0) view.v[v] -= vn * normal;
+        }
+        checksum += view.x[v].x() + view.x[v].y() + view.x[v].z() + view.v[v].x() + view.v[v].y() + view.v[v].z();
+        max_speed2 = std::max(max_speed2, view.v[v].squaredNorm());
       }
-      view.v[v] = moved * inv_h;
-      if (sc.wall_touched[v]) {
-        sc.wall_touched[v] = 0;
-        const Vec3 radial = view.x[v] - wall_.center();
-        const Vec3 normal = radial * (1.0 / radial.norm());  // touched: on the wall, never at the centre
-        const double vn = view.v[v].dot(normal);
-        if (vn > 0.0) view.v[v] -= vn * normal;
-      }
-      checksum += view.x[v].x() + view.x[v].y() + view.x[v].z() + view.v[v].x() + view.v[v].y() + view.v[v].z();
-      double& m = sc.block_max_speed2[v / Surface::kSleepBlock];
-      m = std::max(m, view.v[v].squaredNorm());
+      sc.block_max_move2[block] = max_move2;
+      sc.block_max_speed2[block] = max_speed2;
+      if (!std::isfinite(checksum)) finite.store(false, std::memory_order_relaxed);
     });
     for (std::uint32_t b = 0; b < s.block_count(); ++b) {
       if (sc.block_max_move2[b] > 0.0) sc.block_step_drift_mm[b] += std::sqrt(sc.block_max_move2[b]);
     }
   }
-  return std::isfinite(checksum);
+  return finite.load(std::memory_order_relaxed);
 }
 
 void TissueWorld::prepare_sleep_groups() {
-  for (std::size_t si = 0; si < surfaces_.size(); ++si) scratch_[si].groups.update(*surfaces_[si]);
+  for (std::size_t si = 0; si < surfaces_.size(); ++si) {
+    const Surface& s = *surfaces_[si];
+    Scratch& sc = scratch_[si];
+    sc.groups.update(s);
+    sc.awake_block_count = 0;
+    for (std::uint32_t b = 0; b < s.block_count(); ++b) {
+      if (s.block_awake(b)) sc.awake_blocks[sc.awake_block_count++] = b;
+    }
+  }
 }
 
 void TissueWorld::finish_sleep() {

@@ -80,6 +80,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.momentum.assign(cap, 0);
   const std::size_t blocks = surface->block_count();
   s.block_was_awake.assign(blocks, 0);
+  s.awake_blocks.assign(blocks, 0);
   s.wake_request.assign(blocks, 0);
   s.block_max_speed2.assign(blocks, 0.0);
   s.block_max_move2.assign(blocks, 0.0);
@@ -105,6 +106,13 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   scratch_.push_back(std::move(s));
   contact_force_.assign(std::size_t{kMaxColliders} * surfaces_.size(), Vec3::Zero());
   return static_cast<std::uint32_t>(surfaces_.size() - 1);
+}
+
+void TissueWorld::set_worker_threads(unsigned threads) {
+  if (threads < 1 || threads > 64) throw InvalidArgument("worker threads: must be 1..64, got " + std::to_string(threads));
+  if (threads == worker_threads()) return;
+  workers_.reset();
+  if (threads > 1) workers_ = std::make_unique<WorkerPool>(threads);
 }
 
 void TissueWorld::set_topology_hook(std::uint32_t surface, std::unique_ptr<TopologyHook> hook) {

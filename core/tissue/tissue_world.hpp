@@ -4,8 +4,9 @@
 //
 // Structure after MuJoCo's "constant model, mutable data" idea, kept simple: everything is built
 // before the loop (add_surface, add_attachment, add_local_force), then step() is called at a fixed
-// rate with dt as a parameter. The world owns no clock and no thread; two worlds built and stepped
-// the same way end in the same bits (state_hash()).
+// rate with dt as a parameter. The world owns no clock; its only threads are an optional worker pool
+// with a fixed partition (set_worker_threads). Two worlds built and stepped the same way end in the
+// same bits (state_hash()), whatever their thread counts.
 //
 // The solver is implicit Euler solved by Vertex Block Descent (Chen, Liu, Yang & Yuksel 2024): each
 // substep minimises the incremental potential ½|x − x̃|²_M/h² + E(x) by Gauss–Seidel sweeps over the
@@ -16,6 +17,7 @@
 // and sweeps. Sweeps that do not converge leave the tissue slow (damped), never soft; an XPBD sweep
 // started from the prediction x̃ settles many times softer than the material instead
 // (core/README.md, "The solver", has the argument and the measurements).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -25,6 +27,7 @@
 #include <vector>
 
 #include "core/common/status.hpp"
+#include "core/common/worker_pool.hpp"
 #include "core/common/types.hpp"
 #include "core/common/units.hpp"
 #include "core/tissue/globe_wall.hpp"
@@ -263,6 +266,12 @@ class TissueWorld {
   // For tests: lay the vertex sweep's terms out afresh every step instead of keeping the layout
   // while the topology and the awake region stand (the results are the same, bit for bit).
   void set_relayout_every_step(bool on) { relayout_every_step_ = on; }
+  // Threads the step's independent per-vertex and per-stencil passes are split over (1..64, the
+  // calling thread included; the vertex sweep itself stays on the calling thread). The state is the
+  // same bit for bit at any count (core/common/worker_pool.hpp); not part of it. Throws
+  // InvalidArgument outside 1..64.
+  void set_worker_threads(unsigned threads);
+  unsigned worker_threads() const { return workers_ ? workers_->threads() : 1; }
   // How many times a surface's layout was kept (its values refreshed) instead of rebuilt. Not state.
   std::uint64_t layouts_kept() const { return layouts_kept_; }
   std::uint32_t attachment_count() const { return static_cast<std::uint32_t>(attachments_.size()); }
@@ -400,6 +409,10 @@ class TissueWorld {
 
     // Sleeping bookkeeping, per vertex block.
     std::vector<std::uint8_t> block_was_awake;  // awake during the previous step
+    // This step's awake blocks in order (listed at its start: blocks wake and sleep only between
+    // the substeps and the step's end), the items the worker pool splits (for_awake_blocks).
+    std::vector<std::uint32_t> awake_blocks;
+    std::uint32_t awake_block_count = 0;
     std::vector<std::uint8_t> wake_request;     // set during a step, applied at its end
     std::vector<double> block_max_speed2;
     // Largest displacement² of each block's vertices in the current substep, and their sum (of
@@ -468,6 +481,17 @@ class TissueWorld {
   void find_overstrained();
   void tear_overstrained();
   void creep_and_tidy(double dt_s);
+  // Calls f(block, first vertex, end vertex) for each of surface si's awake blocks of this step,
+  // split over the worker pool's threads: only for passes whose blocks are independent.
+  template <class F>
+  void for_awake_blocks(std::uint32_t si, F&& f);
+  // The same per vertex: f(v) for every vertex slot of the awake blocks.
+  template <class F>
+  void for_awake_vertices(std::uint32_t si, F&& f) {
+    for_awake_blocks(si, [&](std::uint32_t, std::uint32_t first, std::uint32_t end) {
+      for (std::uint32_t v = first; v < end; ++v) f(v);
+    });
+  }
   void prepare_sleep_groups();
   void finish_sleep();
   template <class F>
@@ -479,6 +503,7 @@ class TissueWorld {
   Environment environment_;
   SolverSettings settings_;
   bool relayout_every_step_ = false;
+  std::unique_ptr<WorkerPool> workers_;  // null: the step runs on the calling thread alone
   std::uint64_t layouts_kept_ = 0;
   std::vector<std::unique_ptr<Surface>> surfaces_;
   std::vector<std::unique_ptr<TopologyHook>> hooks_;  // per surface, may be null
@@ -522,6 +547,18 @@ class TissueWorld {
 template <class F>
 void TissueWorld::for_each_active_edge(std::uint32_t si, F&& f) {
   scratch_[si].groups.for_each_active(f);
+}
+
+template <class F>
+void TissueWorld::for_awake_blocks(std::uint32_t si, F&& f) {
+  const Scratch& sc = scratch_[si];
+  const std::uint32_t n = surfaces_[si]->vertex_slots();
+  run_sliced(workers_.get(), sc.awake_block_count, [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const std::uint32_t b = sc.awake_blocks[i];
+      f(b, b * Surface::kSleepBlock, std::min(n, (b + 1) * Surface::kSleepBlock));
+    }
+  });
 }
 
 template <class Severs>

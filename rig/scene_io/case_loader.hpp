@@ -23,6 +23,9 @@ struct CaseLoadOptions {
   // cannot step the full one at 1 kHz, small textures for tests.
   int retina_vertices = 0;
   int texture_size_px = 0;
+  // Threads of the tissue step's worker pool (core::TissueWorld::set_worker_threads, 1..64). Not
+  // recorded: the state is the same bit for bit at any count, so a replay may use another.
+  unsigned physics_threads = 1;
 };
 
 // A case file as text: enough to rebuild it anywhere.

@@ -98,6 +98,7 @@ std::unique_ptr<PreparedCase> prepare_case(const std::vector<scene_io::CaseText>
   scene_io::LoadedCase loaded = scene_io::load_case(cases[static_cast<std::size_t>(index)], options);
   out->from_cache = loaded.from_cache;
   out->scene = std::make_unique<core::Scene>(std::move(loaded.scene));
+  out->scene->world.set_worker_threads(options.physics_threads);
   core::Scene& s = *out->scene;
   out->start_hash = s.world.state_hash();
   out->focus_mm = region_of_interest(s);

@@ -14,6 +14,9 @@
 // step-time curve of the solver's knobs. BM_TissueStepRelayout is BM_TissueStep with the vertex
 // sweep's layout rebuilt every step (TissueWorld::set_relayout_every_step), as the solver did until
 // it kept the layout while the topology and the awake region stand: what keeping it saves.
+// BM_TissueStepThreads is BM_TissueStep with the step's independent passes split over a worker pool
+// of 1 or 2 threads (TissueWorld::set_worker_threads; the vertex sweep stays on one): its time is
+// wall-clock (UseRealTime), since a second thread's work does not show in the caller's CPU time.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -42,7 +45,8 @@ void report_quantiles(benchmark::State& state, std::vector<double>& samples_us, 
       benchmark::Counter(projections_per_step * static_cast<double>(samples_us.size()), benchmark::Counter::kIsRate);
 }
 
-void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, const SolverSettings& solver, bool relayout = false) {
+void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, const SolverSettings& solver, bool relayout = false,
+                     unsigned threads = 1) {
   RetinaCapOptions o;
   o.retina_vertices = vertices_wanted;
   o.membrane = true;
@@ -51,6 +55,7 @@ void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, co
   auto scene = build_retina_cap(o);
   TissueWorld& world = scene.world;
   world.set_relayout_every_step(relayout);
+  world.set_worker_threads(threads);
   // Warm-up: the detachment lifts and settles; the attached retina goes to sleep.
   for (int i = 0; i < 1000; ++i) world.step(1e-3);
   const std::uint64_t kept_before = world.layouts_kept();
@@ -87,6 +92,7 @@ void run_tissue_step(benchmark::State& state, int vertices_wanted, Load load, co
   state.counters["attachments"] = world.attachment_count();
   state.counters["substeps"] = world.settings().substeps;
   state.counters["iterations"] = world.settings().iterations;
+  state.counters["threads"] = world.worker_threads();
   state.counters["awake_fraction"] = step > 0 ? awake_sum / static_cast<double>(step) : 0.0;
   // Surfaces whose sweep layout was kept (values refreshed, not laid out afresh), per step.
   state.counters["layouts_kept_per_step"] = step > 0 ? static_cast<double>(world.layouts_kept() - kept_before) / static_cast<double>(step) : 0.0;
@@ -112,6 +118,12 @@ void BM_TissueStepRelayout(benchmark::State& state) {
   run_tissue_step(state, static_cast<int>(state.range(0)), static_cast<Load>(state.range(1)), solver, true);
 }
 
+void BM_TissueStepThreads(benchmark::State& state) {
+  SolverSettings solver;
+  run_tissue_step(state, static_cast<int>(state.range(0)), static_cast<Load>(state.range(1)), solver, false,
+                  static_cast<unsigned>(state.range(2)));
+}
+
 }  // namespace
 
 BENCHMARK(BM_TissueStep)
@@ -130,4 +142,11 @@ BENCHMARK(BM_TissueStepRelayout)
     ->ArgNames({"vertices", "load"})
     ->ArgsProduct({{20000}, {kWorking, kAllAwake}})
     ->Unit(benchmark::kMicrosecond)
+    ->MinTime(2.0);
+
+BENCHMARK(BM_TissueStepThreads)
+    ->ArgNames({"vertices", "load", "threads"})
+    ->ArgsProduct({{20000, 80000}, {kWorking, kAllAwake}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
     ->MinTime(2.0);
