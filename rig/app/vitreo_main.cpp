@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
   app.add_option("--physics-threads", physics_threads,
                  "threads the tissue step splits its independent passes over (1-64; the vertex sweep stays on one).\n"
                  "The simulation's state is the same bit for bit at any count; more threads only shorten the step\n"
-                 "on a machine with cores to spare (default 1)")
+                 "on a machine with cores to spare (default 1; not with --realtime)")
       ->check(CLI::Range(1u, 64u));
   auto* texture_opt = app.add_option("--texture-size", texture_px, "fundus texture size override in pixels (0 = the case's own)")
                           ->check(CLI::Range(0, 8192));
@@ -196,6 +196,13 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "vitreo: %s\n", e.what());  // one line; --help lists the options
+    return 2;
+  }
+  if (realtime && physics_threads > 1) {
+    // The workers would be started by the physics thread and inherit its one pinned core and its
+    // FIFO priority: they would take turns with it instead of running beside it.
+    std::fprintf(stderr, "vitreo: --physics-threads %u with --realtime: the step's workers are not placed on cores of their own yet, "
+                 "so they would share the pinned physics core; use one of the two\n", physics_threads);
     return 2;
   }
 

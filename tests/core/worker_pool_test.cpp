@@ -1,5 +1,4 @@
-// The tissue step's worker pool: every part runs once per pass on its fixed thread, slices cover
-// the items exactly once, and — what the pool is for — the tissue world's state is the same bit for
+// The tissue step's worker pool: every part runs once per pass, slices cover the items exactly once, and — what the pool is for — the tissue world's state is the same bit for
 // bit at any thread count, through tears, changed rest lengths, suction, snapshots and a rolled-back
 // step. Run under ThreadSanitizer by the tsan preset (label `threads`).
 #include <gtest/gtest.h>
@@ -18,11 +17,13 @@
 
 using namespace vitreo::core;
 
-TEST(WorkerPool, EveryPartRunsOncePerPassOnItsOwnThread) {
-  for (unsigned threads : {1u, 2u, 3u, 5u}) {
+TEST(WorkerPool, EveryPartRunsOncePerPass) {
+  // 8 threads on this 2-core machine too: workers the kernel has not scheduled yet leave their
+  // parts to the caller, and a worker late for one pass must not run a part twice in the next.
+  for (unsigned threads : {1u, 2u, 3u, 5u, 8u}) {
     WorkerPool pool(threads);
     ASSERT_EQ(pool.threads(), threads);
-    std::vector<std::thread::id> first(threads);
+    std::set<std::thread::id> helpers;
     for (int pass = 0; pass < 2000; ++pass) {
       std::vector<std::atomic<int>> calls(threads);
       std::vector<std::thread::id> ran_on(threads);
@@ -33,10 +34,9 @@ TEST(WorkerPool, EveryPartRunsOncePerPassOnItsOwnThread) {
       pool.run(part);
       for (unsigned p = 0; p < threads; ++p) ASSERT_EQ(calls[p].load(), 1) << threads << " threads, pass " << pass << ", part " << p;
       EXPECT_EQ(ran_on[0], std::this_thread::get_id()) << "part 0 runs on the caller";
-      if (pass == 0) first = ran_on;
-      ASSERT_EQ(ran_on, first) << "a part always runs on the same thread (a fixed partition)";
+      helpers.insert(ran_on.begin(), ran_on.end());
     }
-    EXPECT_EQ(std::set<std::thread::id>(first.begin(), first.end()).size(), threads) << "one thread per part";
+    EXPECT_LE(helpers.size(), threads) << "the pool's own threads only";
   }
 }
 

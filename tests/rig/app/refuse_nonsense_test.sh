@@ -48,6 +48,10 @@ refused "vitreo --pedal-config /dev/zero" "not a regular file" "$vitreo" --no-re
 for v in nan inf -inf 1e999 -3 0; do
   refused "vitreo --duration $v" "is not a number in" "$vitreo" --duration "$v" --no-render
 done
+for v in 0 65 -1 two; do
+  refused "vitreo --physics-threads $v" "physics-threads" "$vitreo" --physics-threads "$v" --no-render --out "$tmp/o"
+done
+refused "vitreo --physics-threads 2 --realtime" "share the pinned physics core" "$vitreo" --physics-threads 2 --realtime --no-render --out "$tmp/o"
 refused "vitreo --serial foo=/dev/null" "unknown device kind 'foo'" "$vitreo" --no-render --out "$tmp/o" --serial foo=/dev/null
 refused "vitreo --serial tracker=/dev/null" "is not a serial port" "$vitreo" --no-render --out "$tmp/o" --serial tracker=/dev/null
 refused "vitreo --serial tracker=<a regular file>" "is not a serial port" "$vitreo" --no-render --out "$tmp/o" --serial "tracker=$tmp/header.toml"
