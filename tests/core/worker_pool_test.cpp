@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <set>
@@ -38,6 +39,29 @@ TEST(WorkerPool, EveryPartRunsOncePerPass) {
     }
     EXPECT_LE(helpers.size(), threads) << "the pool's own threads only";
   }
+}
+
+TEST(WorkerPool, AWorkerRunsItsPartBesideTheCaller) {
+  // The caller's part waits (up to 5 s) for the worker's to start: it can only see it start if the
+  // two run at the same time, which is what the pool is for (and what TSan then watches).
+  WorkerPool pool(2);
+  std::atomic<bool> started{false};
+  bool seen = false;
+  std::thread::id worker;
+  auto part = [&](unsigned p) {
+    if (p == 1) {
+      worker = std::this_thread::get_id();
+      started.store(true, std::memory_order_release);
+      return;
+    }
+    for (int i = 0; i < 5000 && !seen; ++i) {
+      seen = started.load(std::memory_order_acquire);
+      if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  };
+  pool.run(part);
+  EXPECT_TRUE(seen) << "the worker never started its part while the caller ran its own";
+  EXPECT_NE(worker, std::this_thread::get_id());
 }
 
 TEST(WorkerPool, SlicesCoverTheItemsExactlyOnce) {
