@@ -1,5 +1,7 @@
 #pragma once
-// Iteration over the vertices of awake blocks only (see Surface::kSleepBlock).
+// Iteration over the vertices of awake blocks only (see Surface::kSleepBlock), in order, on the
+// calling thread. Inside a step, passes whose vertices are independent use
+// TissueWorld::for_awake_vertices instead: the same vertices, split over the worker pool.
 #include <algorithm>
 #include <cstdint>
 
