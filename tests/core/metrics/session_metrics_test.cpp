@@ -4,10 +4,12 @@
 
 #include <random>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <tuple>
+#include <vector>
 
 #include "alloc_counter.hpp"
 #include "core/metrics/session_metrics.hpp"
@@ -125,27 +127,45 @@ TEST(SessionMetrics, OdometerIgnoresSensorJitter) {
   EXPECT_NEAR(m.totals().path_length_mm, 2.0, 0.1);
 }
 
-// Presses the sheet twice: `first` and `second` steps of contact at depth `depth`, apart.
+// Presses the sheet twice, held `first` and `second` steps at depth `depth` below its rest surface,
+// apart. The tip comes down from 1 mm above and goes back up at `speed_mm_s`, a quick surgeon's
+// move: a tip that jumps onto the sheet in one step flings it off (it comes back and is touched
+// again), and one lifted slower than the sheet springs back is caught up and bounced on — each a
+// second contact in this undamped bench (core/tissue/MEASUREMENTS.md, 2026-11-28 eighteenth
+// session: 20 mm/s gave two contacts 0–0.5 mm off the centre, a jump or 5–10 mm/s 3–9).
 struct ContactScript {
   int first = 200, second = 120;
   double depth = 0.3;
+  double speed_mm_s = 20.0;
+  // The tip's height at each step, and how many of those steps its end (radius r) is below the
+  // sheet's rest surface (z = 0): the longest a press can touch.
+  std::vector<double> heights() const {
+    std::vector<double> z;
+    const double step = speed_mm_s * kDt;
+    const auto press = [&](int hold) {
+      for (double h = 1.0 - step; h > -depth; h -= step) z.push_back(h);
+      z.insert(z.end(), hold, -depth);
+      for (double h = -depth + step; h < 1.0; h += step) z.push_back(h);
+      z.insert(z.end(), 100, 1.0);
+    };
+    z.assign(50, 1.0);
+    press(first);
+    press(second);
+    return z;
+  }
 };
 
+int steps_below_rest_surface(const std::vector<double>& heights, double tip_radius_mm) {
+  return static_cast<int>(std::count_if(heights.begin(), heights.end(), [&](double h) { return h - tip_radius_mm < 0.0; }));
+}
+
 void run_contacts(Bench& b, SessionMetrics& m, const ContactScript& s, double* impulse = nullptr, double* peak = nullptr) {
-  const Vec3 up(0.0, 0.0, 1.0), down(0.0, 0.0, -s.depth);
   double sum = 0.0, max = 0.0;
-  const auto phase = [&](const Vec3& p, int steps) {
-    for (int i = 0; i < steps; ++i) {
-      step_and_observe(b, m, p);
-      sum += b.instruments->instrument(0).retina_force_un * kDt;
-      max = std::max(max, b.instruments->instrument(0).retina_force_un);
-    }
-  };
-  phase(up, 50);
-  phase(down, s.first);
-  phase(up, 100);
-  phase(down, s.second);
-  phase(up, 100);
+  for (const double z : s.heights()) {
+    step_and_observe(b, m, Vec3(0.0, 0.0, z));
+    sum += b.instruments->instrument(0).retina_force_un * kDt;
+    max = std::max(max, b.instruments->instrument(0).retina_force_un);
+  }
   if (impulse) *impulse = sum;
   if (peak) *peak = max;
 }
@@ -159,9 +179,11 @@ TEST(SessionMetrics, ScriptedContactsGiveTheirCountAndDuration) {
   const ContactScript s;
   run_contacts(b, m, s, &impulse, &peak);
   EXPECT_EQ(m.totals().retina_contacts, 2u);
-  // The tip jumps 1.3 mm in one step, far faster than the sheet can follow: each contact lasts as
-  // long as the script holds the tip down, to within a step at either end.
-  EXPECT_NEAR(m.totals().retina_contact_time_s, (s.first + s.second) * kDt, 2.5 * kDt);
+  // Each contact lasts at least as long as the script holds the tip down, and at most while the
+  // tip's end is below the sheet's rest surface (the sheet, pushed down, springs back after it).
+  const int below = steps_below_rest_surface(s.heights(), shaft_radius_mm(Gauge::k23));
+  EXPECT_GE(m.totals().retina_contact_time_s, (s.first + s.second) * kDt);
+  EXPECT_LE(m.totals().retina_contact_time_s, below * kDt);
   EXPECT_EQ(m.instrument(0).retina_contacts, 2u);
   EXPECT_GT(peak, 10.0);
   EXPECT_DOUBLE_EQ(m.totals().peak_retina_force_un, peak);
@@ -171,28 +193,26 @@ TEST(SessionMetrics, ScriptedContactsGiveTheirCountAndDuration) {
 }
 
 TEST(SessionMetrics, TimeAboveTheDamageLimitIsCounted) {
-  // A limit below the force of a held press (the sheet's tension on the tip, several hundred µN
-  // here): the time above it is the scripted contact time; the script's force trace, summed here,
-  // is the exact reference.
+  // A limit below the force of a held press (the sheet's tension on the tip, about 1000 µN here):
+  // the time above it is at least the time the script holds the tip down and at most the contact
+  // time; the script's force trace, counted here, is the exact reference.
   Bench b;
   MetricsOptions o;
   o.retina_force_limit_un = 300.0;
   SessionMetrics m(b.world, b.metrics_case(), b.instruments.get(), o);
   const ContactScript s;
-  const Vec3 up(0.0, 0.0, 1.0), down(0.0, 0.0, -s.depth);
   int over = 0;
-  for (const auto& [p, steps] : {std::pair{up, 50}, {down, s.first}, {up, 100}, {down, s.second}, {up, 100}}) {
-    for (int i = 0; i < steps; ++i) {
-      step_and_observe(b, m, p);
-      if (b.instruments->instrument(0).retina_force_un > o.retina_force_limit_un) ++over;
-    }
+  for (const double z : s.heights()) {
+    step_and_observe(b, m, Vec3(0.0, 0.0, z));
+    if (b.instruments->instrument(0).retina_force_un > o.retina_force_limit_un) ++over;
   }
-  EXPECT_DOUBLE_EQ(m.totals().time_over_force_limit_s, over * kDt);
-  EXPECT_NEAR(m.totals().time_over_force_limit_s, (s.first + s.second) * kDt, 2.5 * kDt);
+  EXPECT_NEAR(m.totals().time_over_force_limit_s, over * kDt, 1e-9);  // summed step by step
+  EXPECT_GE(m.totals().time_over_force_limit_s, (s.first + s.second) * kDt);
+  EXPECT_LE(m.totals().time_over_force_limit_s, m.totals().retina_contact_time_s + 1e-9);  // both sums of the same steps
   EXPECT_EQ(m.totals().force_limit_un, 300.0);
-  // With the instruments' own limit (3000 µN) the same press made at a surgeon's speed (5 mm/s
-  // down, held, back up) never damages the sheet. (The script's 1.3 mm jump in one step is an
-  // impact: at the sheet's nominal stiffness its first milliseconds exceed 3000 µN.)
+  // With the instruments' own limit (3000 µN) the same press made slowly (5 mm/s down, held, back
+  // up) never damages the sheet.
+  const Vec3 down(0.0, 0.0, -s.depth);
   Bench b2;
   SessionMetrics m2(b2.world, b2.metrics_case(), b2.instruments.get());
   double held = 0.0;
@@ -244,8 +264,13 @@ TEST(SessionMetrics, ObserveCriteriaAndScoreDoNotAllocate) {
   delete probe;
   ASSERT_EQ(test::AllocationCounter::allocations, 2);
   test::AllocationCounter::allocations = 0;
-  for (int i = 0; i < 300; ++i) {
-    b.step_at(Vec3(0.0, 0.0, i % 100 < 50 ? 1.0 : -0.3));
+  ContactScript presses;  // three presses of 50 steps
+  presses.first = presses.second = 50;
+  std::vector<double> heights = presses.heights();
+  const std::vector<double> third(heights.begin() + 50, heights.begin() + 50 + (static_cast<long>(heights.size()) - 50) / 2);
+  heights.insert(heights.end(), third.begin(), third.end());
+  for (const double z : heights) {
+    b.step_at(Vec3(0.0, 0.0, z));
     test::AllocationCounter::counting = true;
     const Status st = m.observe(kDt);
     const ScoreCard& card = m.score();
