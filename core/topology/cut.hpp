@@ -181,6 +181,7 @@ class Cutter {
   Vec3 tip_position(const CrackTip& tip) const;
   void hold(const CrackTip& tip);
   bool taken(const Spot& at) const;
+  bool catch_up(Incision& inc, const Spot& p, CutResult& r);
   // Brings a tip's anchors up to date after edits (false: the tip could not be found again).
   bool reanchor(CrackTip& tip);
   void reanchor_tips(Incision& inc, CutResult& r);
