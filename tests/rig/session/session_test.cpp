@@ -19,6 +19,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "core/scene/snapshot.hpp"
 #include "rig/scene_io/case_loader.hpp"
@@ -49,6 +50,29 @@ const char* kPedals = "device pedals\nrate_hz 500\nserial 2001\nkey 0 0 0 0\nkey
 std::string temp_path(const std::string& name) {
   return (std::filesystem::path(::testing::TempDir()) / ("vitreo-" + std::to_string(::getpid()) + "-" + name)).string();
 }
+
+// Every session here (and in telemetry_contract_test.cpp) writes its logs, recordings and frames
+// under TempDir() with the process id in the name, and ctest runs each test in a process of its
+// own: left there, every run of the suite added some 30 files to /tmp. A passing run removes its
+// own; a failing one keeps them to look at.
+class RemoveThisProcessTempFilesIfPassed : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (!::testing::UnitTest::GetInstance()->Passed()) return;
+    const std::string pid = std::to_string(::getpid());
+    const std::string prefixes[] = {"vitreo-" + pid + "-", "vitreo-contract-" + pid + "-"};
+    std::error_code ec;
+    std::vector<std::filesystem::path> ours;
+    for (const auto& entry : std::filesystem::directory_iterator(::testing::TempDir(), ec)) {
+      const std::string name = entry.path().filename().string();
+      for (const auto& prefix : prefixes) {
+        if (name.starts_with(prefix)) ours.push_back(entry.path());
+      }
+    }
+    for (const auto& path : ours) std::filesystem::remove_all(path, ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kRemoveTempFiles = ::testing::AddGlobalTestEnvironment(new RemoveThisProcessTempFilesIfPassed);
 
 const std::string kScenes = std::string(VITREO_SOURCE_DIR) + "/scenes";
 
