@@ -26,11 +26,7 @@
 //     the sweep.
 // So a sweep shorter than a triangle changes nothing until the cut leaves the triangle, and the same
 // path cut in one sweep or in a thousand inserts the same crossings and opens the same springs
-// (sampling only moves the interior points at bends, within the kink tolerance). Where a crack's
-// walk stops within snapping distance short of the blade (a blade running along a row of springs
-// has the vertices in its plane, and each walk stops at the vertex the blade has only just
-// passed), the crack goes on to the blade's point in the same sweep (Cutter::catch_up) rather
-// than wait there while a second crack starts at the blade. A cut meeting
+// (sampling only moves the interior points at bends, within the kink tolerance). A cut meeting
 // the tissue's boundary — its outer edge, or a cut made before, the same incision's included —
 // ends there and a new crack starts where the polygon enters the tissue again, so closed and
 // self-crossing paths part the tissue.
@@ -185,7 +181,6 @@ class Cutter {
   Vec3 tip_position(const CrackTip& tip) const;
   void hold(const CrackTip& tip);
   bool taken(const Spot& at) const;
-  bool catch_up(Incision& inc, const Spot& p, CutResult& r);
   // Brings a tip's anchors up to date after edits (false: the tip could not be found again).
   bool reanchor(CrackTip& tip);
   void reanchor_tips(Incision& inc, CutResult& r);

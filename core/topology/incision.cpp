@@ -789,37 +789,6 @@ bool Cutter::reanchor(CrackTip& tip) {
   return restart_at_pending();
 }
 
-// The blade's point p, which no walk reached: a crack tip whose walk stopped within snapping
-// distance of it (at a vertex the blade had just passed: the plane of a blade moving along a row of
-// springs runs through the vertices) goes on to p. Left alone, the tip would wait there for ever —
-// the next sweeps lie ahead of it — and a new crack would start at p: two cracks for one blade,
-// the first cut only when the incision ends.
-bool Cutter::catch_up(Incision& inc, const Spot& p, CutResult& r) {
-  const double near = std::max(settings_.min_piece_mm, settings_.band_mm);
-  CrackTip* behind = nullptr;
-  double best = near;
-  for (std::uint32_t i = 0; i < inc.ntips_; ++i) {
-    const double d = (tip_position(inc.tips_[i]) - p.x).norm();
-    if (d <= best) {
-      best = d;
-      behind = &inc.tips_[i];
-    }
-  }
-  if (behind == nullptr) return false;
-  CrackTip& tip = *behind;
-  if (!in_star(tip, p.tri)) {
-    // p lies beyond the triangles around the origin: the crack first reaches where it stopped
-    // (inserted there: snapped onto the vertex it stopped at, as a walk leaving the star would).
-    commit(tip, tip_spot(tip), r, false);
-    const Surface& s = surface_;
-    const bool current = s.triangle_alive(p.tri) && s.triangle_id(p.tri).generation == p.generation;
-    if (!tip.origin_inserted || !current || !in_star(tip, p.tri)) return false;
-  }
-  set_pending(tip, p);
-  hold(tip);
-  return true;
-}
-
 void Cutter::reanchor_tips(Incision& inc, CutResult& r) {
   std::uint32_t kept = 0;
   for (std::uint32_t i = 0; i < inc.ntips_; ++i) {
@@ -939,12 +908,9 @@ void Cutter::sweep_once(Incision& inc, const BladeEdge& from, const BladeEdge& t
         ++r.gaps;
       }
     }
-    // Where the blade now is in the tissue but no walk led (the tissue moved onto it): a crack
-    // starts — unless a crack stopped a hair behind it (its walk ended at a vertex or spring the
-    // blade had only just passed), which goes on to it instead.
+    // Where the blade now is in the tissue but no walk led (the tissue moved onto it): a crack starts.
     for (const Spot& p : trailing_) {
       if (taken(p)) continue;
-      if (catch_up(inc, p, r)) continue;
       if (inc.ntips_ >= Incision::kMaxCrackTips) {
         ++r.gaps;
         continue;
