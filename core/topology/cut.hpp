@@ -26,7 +26,10 @@
 //     the sweep.
 // So a sweep shorter than a triangle changes nothing until the cut leaves the triangle, and the same
 // path cut in one sweep or in a thousand inserts the same crossings and opens the same springs
-// (sampling only moves the interior points at bends, within the kink tolerance). A cut meeting
+// (sampling only moves the interior points at bends, within the kink tolerance). Where the blade's
+// plane runs along a row of springs, through their vertices, the point where a walk stops lies a
+// hair from a vertex: the next walk looks round that vertex, and the blade's point there is that
+// crack's, not a new one's (so a slow blade's slit keeps one spring behind it). A cut meeting
 // the tissue's boundary — its outer edge, or a cut made before, the same incision's included —
 // ends there and a new crack starts where the polygon enters the tissue again, so closed and
 // self-crossing paths part the tissue.
@@ -181,6 +184,7 @@ class Cutter {
   Vec3 tip_position(const CrackTip& tip) const;
   void hold(const CrackTip& tip);
   bool taken(const Spot& at) const;
+  bool at_crack_point(const Incision& inc, const Spot& p) const;
   // Brings a tip's anchors up to date after edits (false: the tip could not be found again).
   bool reanchor(CrackTip& tip);
   void reanchor_tips(Incision& inc, CutResult& r);

@@ -474,6 +474,16 @@ bool Cutter::next_piece(const CrackTip& tip, const Spot& c, const Spot* back, st
     for (auto t : s.edge_triangles(c.edge)) {
       if (t != kNone) star_.push_back(t);
     }
+    // A point on a spring all but at one of its ends (the blade's point where its plane runs
+    // along a row of springs, through their vertices): the triangles round that end too.
+    constexpr double kNear = 1e-6;
+    const auto tv = s.triangle_vertices(c.tri);
+    for (std::size_t j = 0; j < 3; ++j) {
+      if (!(c.bary[j] > 1.0 - kNear)) continue;
+      s.for_each_triangle_of(tv[j], [&](std::uint32_t t, std::uint32_t) {
+        if (std::find(star_.begin(), star_.end(), t) == star_.end() && star_.size() < star_.capacity()) star_.push_back(t);
+      });
+    }
   } else {
     s.for_each_triangle_of(c.vertex, [&](std::uint32_t t, std::uint32_t) {
       if (star_.size() < star_.capacity()) star_.push_back(t);
@@ -789,6 +799,22 @@ bool Cutter::reanchor(CrackTip& tip) {
   return restart_at_pending();
 }
 
+// Whether a crack's walk stopped at p this sweep (its blade point lies within the band of it). The
+// walk's last piece and p can lie in different triangles round the vertex the blade is passing (its
+// plane running along a row of springs), so `taken` does not see it; without this a second crack
+// started there, and the two met further on (core/tissue/MEASUREMENTS.md, 2026-11-28).
+bool Cutter::at_crack_point(const Incision& inc, const Spot& p) const {
+  const Surface& s = surface_;
+  for (std::uint32_t i = 0; i < inc.ntips_; ++i) {
+    const CrackTip& t = inc.tips_[i];
+    if (!t.has_pending || !s.triangle_alive(t.pending.triangle.index) || s.triangle_id(t.pending.triangle.index) != t.pending.triangle) {
+      continue;
+    }
+    if ((spot_of(t.pending).x - p.x).norm() <= settings_.band_mm) return true;
+  }
+  return false;
+}
+
 void Cutter::reanchor_tips(Incision& inc, CutResult& r) {
   std::uint32_t kept = 0;
   for (std::uint32_t i = 0; i < inc.ntips_; ++i) {
@@ -910,7 +936,7 @@ void Cutter::sweep_once(Incision& inc, const BladeEdge& from, const BladeEdge& t
     }
     // Where the blade now is in the tissue but no walk led (the tissue moved onto it): a crack starts.
     for (const Spot& p : trailing_) {
-      if (taken(p)) continue;
+      if (taken(p) || at_crack_point(inc, p)) continue;
       if (inc.ntips_ >= Incision::kMaxCrackTips) {
         ++r.gaps;
         continue;
