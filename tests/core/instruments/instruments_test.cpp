@@ -722,21 +722,45 @@ TEST(Instruments, PickLiftsOneEdgeWithoutTakingTheOther) {
   for (std::uint32_t g = 0; g < 4; ++g) EXPECT_FALSE(world.grip_active(g));  // a pick never grabs
 }
 
-TEST(Instruments, ABladeCutFollowsItsPath) {
-  TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
-  const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
-  anchor_border(world.surface(m), 4.0);
-  TopologyAdapter topology(world, {m}, {});
-  InstrumentSceneOptions o;
-  o.ports_mm = {Vec3(0, 0, 10)};
-  Simulation sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
-  sys.set_topology(&topology);
-  const std::uint32_t before = world.surface(m).vertex_slots();
-  auto at = [&](double x, double z) {
+// A 4 mm sheet of 20 cells in the plane z = 0, its border anchored, with one cutting instrument
+// through a port 10 mm above its centre and the topology adapter that makes its cuts.
+struct CuttingSheet {
+  static std::uint32_t add_anchored_sheet(TissueWorld& w) {
+    const std::uint32_t s = w.add_surface(sheet(4.0, 20, 0.0));
+    anchor_border(w.surface(s), 4.0);
+    return s;
+  }
+  static InstrumentSceneOptions port_above() {
+    InstrumentSceneOptions o;
+    o.ports_mm = {Vec3(0, 0, 10)};
+    return o;
+  }
+  explicit CuttingSheet(InstrumentKind kind)
+      : m(add_anchored_sheet(world)), topology(world, {m}, {}), sys(world, o, {{kind, Gauge::k23, 0, {}}}) {
+    sys.set_topology(&topology);
+  }
+  // The blade straight down through the port, its tip at height z, moved x along +x.
+  InstrumentInput blade_at(double x, double z) const {
     InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z);
     in.tip_fixture_mm.x() += x;
     return in;
-  };
+  }
+
+  TissueWorld world{GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()};
+  const std::uint32_t m;
+  TopologyAdapter topology;
+  const InstrumentSceneOptions o = port_above();
+  Simulation sys;
+};
+
+TEST(Instruments, ABladeCutFollowsItsPath) {
+  CuttingSheet rig(InstrumentKind::kBlade);
+  TissueWorld& world = rig.world;
+  const std::uint32_t m = rig.m;
+  Simulation& sys = rig.sys;
+  TopologyAdapter& topology = rig.topology;
+  const std::uint32_t before = world.surface(m).vertex_slots();
+  auto at = [&](double x, double z) { return rig.blade_at(x, z); };
   // Plunge at x = −1 to 0.4 mm through the membrane (the blade is 1 mm: its base stays above), then
   // draw it along +x to x = +1 at 10 mm/s.
   for (int i = 0; i <= 50; ++i) {
@@ -778,20 +802,11 @@ TEST(Instruments, ABladeCutFollowsItsPath) {
 TEST(Instruments, ABladeAlongARowOfSpringsOpensOneSlitBehindItAtAnySpeedAndLeavingTheEyeEndsIt) {
   for (const double speed_mm_s : {2.0, 3.0, 4.0, 5.0, 8.0}) {
     SCOPED_TRACE(std::to_string(speed_mm_s) + " mm/s");
-    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
-    const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
-    anchor_border(world.surface(m), 4.0);
-    TopologyAdapter topology(world, {m}, {});
-    InstrumentSceneOptions o;
-    o.ports_mm = {Vec3(0, 0, 10)};
-    Simulation sys(world, o, {{InstrumentKind::kBlade, Gauge::k23, 0, {}}});
-    sys.set_topology(&topology);
-    const Surface& s = world.surface(m);
-    auto at = [&](double x, double z) {
-      InstrumentInput in = InstrumentInput::through_port(o.ports_mm[0], -Vec3::UnitZ(), 10.0 - z);
-      in.tip_fixture_mm.x() += x;
-      return in;
-    };
+    CuttingSheet rig(InstrumentKind::kBlade);
+    Simulation& sys = rig.sys;
+    TopologyAdapter& topology = rig.topology;
+    const Surface& s = rig.world.surface(rig.m);
+    auto at = [&](double x, double z) { return rig.blade_at(x, z); };
     // The open slit's far end along +x (rest shape; the sheet's border is not the slit).
     auto slit_end = [&] {
       double hi = -INFINITY;
@@ -858,14 +873,11 @@ TEST(Instruments, ABladeAlongARowOfSpringsOpensOneSlitBehindItAtAnySpeedAndLeavi
 TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
   for (const int steps : {1, 200}) {
     SCOPED_TRACE(std::to_string(steps) + " steps");
-    TissueWorld world(GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep());
-    const std::uint32_t m = world.add_surface(sheet(4.0, 20, 0.0));
-    anchor_border(world.surface(m), 4.0);
-    TopologyAdapter topology(world, {m}, {});
-    InstrumentSceneOptions o;
-    o.ports_mm = {Vec3(0, 0, 10)};
-    Simulation sys(world, o, {{InstrumentKind::kScissors, Gauge::k23, 0, {}}});
-    sys.set_topology(&topology);
+    CuttingSheet rig(InstrumentKind::kScissors);
+    TissueWorld& world = rig.world;
+    const std::uint32_t m = rig.m;
+    Simulation& sys = rig.sys;
+    TopologyAdapter& topology = rig.topology;
     // The hinge 0.3 mm above the membrane (the tip is a jaw length below it), jaws open in the
     // x–z plane: each jaw pierces it 0.3 · tan 25° = 0.14 mm from under the hinge.
     const double jaw = InstrumentDimensions{}.jaw_length_mm, half = InstrumentDimensions{}.jaw_open_deg * std::numbers::pi / 180.0;
