@@ -161,7 +161,15 @@ int main(int argc, char** argv) {
   app.add_option("--trainee", trainee, "who does the session (1-64 characters of A-Z a-z 0-9 . _ -): kept in OUT/trainee.txt and "
                  "named in the report, for `vitreo-report --trainee ID` (a learning curve)")
       ->check([](const std::string& id) { return vitreo::report::valid_trainee_id(id) ? std::string() : "1-64 characters of A-Z a-z 0-9 . _ -"; });
-  app.add_flag("--idle", idle, "play no script: the simulated hand stays outside the eye, the pedals at rest")->excludes(script_opt);
+  auto* idle_opt = app.add_flag("--idle", idle, "play no script: the simulated hand stays outside the eye, the pedals at rest")->excludes(script_opt);
+  std::uint64_t script_seed = 1;
+  auto* script_seed_opt =
+      app.add_option("--script-seed", script_seed,
+                     "play the script with this seed for its sensor noise and tremor instead of its own `seed` (another\n"
+                     "realisation of the same hand: does the script's outcome hold up, or did one noise sample decide it?)")
+          ->check(CLI::Range(std::uint64_t{0}, std::uint64_t{1'000'000'000'000'000}))  // the script file's own range
+          ->excludes(idle_opt)
+          ->excludes(serial_opt);
   auto* lockstep_opt = app.add_flag("--lockstep", lockstep,
                "simulated devices on the simulation's clock: each step waits for its inputs, so a scripted session\n"
                "receives the same samples at the same steps however loaded the machine is (the default when every\n"
@@ -188,7 +196,7 @@ int main(int argc, char** argv) {
   // A replay takes its cases, resolution and length from the recording: options that would choose
   // them are refused rather than silently ignored.
   for (CLI::Option* o : {case_opt, cases_opt, start_opt, retina_opt, texture_opt, duration_opt, serial_opt, rig_option, lcm_opt, realtime_opt,
-                         stdin_opt, display_opt})
+                         stdin_opt, display_opt, script_seed_opt})
     replay_opt->excludes(o);
   try {
     app.parse(argc, argv);
@@ -285,6 +293,11 @@ int main(int argc, char** argv) {
       std::error_code ec;
       if (fs::exists(expert, ec)) script = vitreo::rig::read_surgical_script(expert);
       else spdlog::warn("{} has no expert script ({}): the simulated hand stays outside the eye", first_file, expert);
+    }
+    if (script_seed_opt->count() > 0) {
+      // Only the simulated devices play a script: a seed with nothing to play it would be ignored.
+      if (script.file.empty()) throw std::runtime_error("--script-seed: no script plays (" + first_file + " has no expert script; name one with --script)");
+      script.seed = script_seed;
     }
     if (script.case_name.empty()) script.case_name = fs::path(first_file).stem().string();
     if (duration_opt->count() == 0 && !script.file.empty()) duration_s = script.duration_s;
@@ -407,7 +420,8 @@ int main(int argc, char** argv) {
     std::printf("  physics threads  %u\n", physics_threads);
     std::printf("  instruments      %s\n", s.instruments.c_str());
     std::printf("  script           %s%s%s\n", script.file.empty() ? "none (idle)" : script.file.c_str(),
-                script.file.empty() ? "" : (" (" + script.kind + ")").c_str(), script.summary.empty() ? "" : (": " + script.summary).c_str());
+                script.file.empty() ? "" : (" (" + script.kind + ", seed " + std::to_string(script.seed) + ")").c_str(),
+                script.summary.empty() ? "" : (": " + script.summary).c_str());
     std::printf("  calibration      %s\n", calibration_in_force.c_str());
     std::printf("  laser            %g mW × %g ms per shot", s.laser_at_start.power_mw, s.laser_at_start.duration_ms);
     if (s.laser_at_end.power_mw != s.laser_at_start.power_mw || s.laser_at_end.duration_ms != s.laser_at_start.duration_ms)
