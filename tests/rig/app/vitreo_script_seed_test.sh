@@ -52,6 +52,7 @@ refused "--script-seed with --idle" 2 --case "$case_file" --idle --script-seed 2
 refused "a negative seed" 2 --case "$case_file" --script-seed -1
 refused "a seed beyond the script file's range" 2 --case "$case_file" --script-seed 1000000000000001
 refused "--script-seed with --replay" 2 --replay "$tmp/s2/session.lcmlog" --script-seed 2
+refused "--script-seed with --serial (real devices play no script)" 2 --case "$case_file" --serial tracker=/dev/null --script-seed 2
 mkdir -p "$tmp/bare"
 cp "$case_file" "$scenes/materials.toml" "$tmp/bare/"
 refused "--script-seed for a case with no expert script" 1 --case "$tmp/bare/low_membrane_macula.toml" --script-seed 2 --duration 1
