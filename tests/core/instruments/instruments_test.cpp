@@ -746,6 +746,27 @@ struct CuttingSheet {
     return in;
   }
 
+  // Where the sheet is open off its anchored border (in the rest shape): the x range of those
+  // boundary vertices and the farthest any lies from the line y = 0 the tests cut along.
+  struct Slit {
+    double lo_x = INFINITY, hi_x = -INFINITY, off_path = 0.0;
+  };
+  Slit slit() const {
+    const Surface& s = world.surface(m);
+    Slit out;
+    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
+      if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
+      for (auto v : s.edge_vertices(e)) {
+        const Vec3& p = s.rest_position(v);
+        if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;  // the border
+        out.off_path = std::max(out.off_path, std::abs(p.y()));
+        out.lo_x = std::min(out.lo_x, p.x());
+        out.hi_x = std::max(out.hi_x, p.x());
+      }
+    }
+    return out;
+  }
+
   TissueWorld world{GlobeWall::sphere(Vec3::Zero(), 12.0), no_pressure(), no_sleep()};
   const std::uint32_t m;
   TopologyAdapter topology;
@@ -851,19 +872,10 @@ TEST(Instruments, ABladeAlongARowOfSpringsOpensOneSlitBehindItAtAnySpeedAndLeavi
     EXPECT_EQ(t.components, 1u) << t.describe();
     EXPECT_EQ(t.boundary_loops, 2u) << "one slit: " << t.describe();
     // The slit runs from x = −0.9 to 0.7 along y = 0: its ends are there (in the rest shape).
-    double lo = INFINITY, hi = -INFINITY;
-    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
-      if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
-      for (auto v : s.edge_vertices(e)) {
-        const Vec3& p = s.rest_position(v);
-        if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;  // the border
-        EXPECT_LT(std::abs(p.y()), 0.02) << "on the path";
-        lo = std::min(lo, p.x());
-        hi = std::max(hi, p.x());
-      }
-    }
-    EXPECT_NEAR(lo, -0.9, 0.02);
-    EXPECT_NEAR(hi, 0.7, 0.02) << "the cut ends where the blade left";
+    const CuttingSheet::Slit slit = rig.slit();
+    EXPECT_LT(slit.off_path, 0.02) << "on the path";
+    EXPECT_NEAR(slit.lo_x, -0.9, 0.02);
+    EXPECT_NEAR(slit.hi_x, 0.7, 0.02) << "the cut ends where the blade left";
   }
 }
 
@@ -896,19 +908,10 @@ TEST(Instruments, ScissorsClosingOnAMembraneCutBetweenTheirJaws) {
     const test::CornerTopology t = test::corner_topology(s);
     EXPECT_EQ(t.components, 1u) << t.describe();
     EXPECT_EQ(t.boundary_loops, 2u) << "one slit between the jaws: " << t.describe();
-    double lo = INFINITY, hi = -INFINITY;
-    for (std::uint32_t e = 0; e < s.edge_slots(); ++e) {
-      if (!s.edge_alive(e) || s.edge_triangles(e)[1] != kNone) continue;
-      for (auto v : s.edge_vertices(e)) {
-        const Vec3& p = s.rest_position(v);
-        if (std::abs(std::abs(p.x()) - 2.0) < 1e-9 || std::abs(std::abs(p.y()) - 2.0) < 1e-9) continue;
-        EXPECT_LT(std::abs(p.y()), 0.02);
-        lo = std::min(lo, p.x());
-        hi = std::max(hi, p.x());
-      }
-    }
-    EXPECT_NEAR(lo, -0.3 * std::tan(half), 0.02);
-    EXPECT_NEAR(hi, 0.3 * std::tan(half), 0.02);
+    const CuttingSheet::Slit slit = rig.slit();
+    EXPECT_LT(slit.off_path, 0.02) << "on the line the jaws close along";
+    EXPECT_NEAR(slit.lo_x, -0.3 * std::tan(half), 0.02);
+    EXPECT_NEAR(slit.hi_x, 0.3 * std::tan(half), 0.02);
   }
 }
 
