@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/scene/snapshot.hpp"
+#include "core/tissue/tissue_world.hpp"
 #include "rig/files/read_text_file.hpp"
 #include "rig/scene_io/scene_file.hpp"
 
@@ -56,7 +57,8 @@ std::string case_cache_key(const CaseText& text, const CaseLoadOptions& options)
   std::uint64_t h = fnv1a(text.text);
   h = fnv1a(text.library_text, h);
   h = fnv1a(std::to_string(kBuilderVersion) + "/" + std::to_string(core::kSnapshotVersion) + "/" +
-                std::to_string(core::kSceneFormatVersion) + "/" + std::to_string(options.retina_vertices),
+                std::to_string(core::kSceneFormatVersion) + "/" + std::to_string(core::kSolverRevision) + "/" +
+                std::to_string(options.retina_vertices),
             h);
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
