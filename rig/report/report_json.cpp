@@ -351,10 +351,19 @@ std::string report_json(const SessionLog& log, const Survey* survey, const std::
   j.field("session_length", last_t, "s");
   j.key("last_step").value(last_step);
   j.key("started_utime_us").value(log.first_utime_us);  // the log's first event (wall clock, µs since the epoch)
-  // The case's pass score (its file's [proficiency] pass_score) and whether this attempt passed: a
-  // final score at or above it.
+  // Whether the case was completed: every criterion but the time limit met, as the criteria were
+  // published with the (final) score — what ended the case early (core/metrics/README.md, "The end
+  // of a case"); false for a session cut short.
+  bool completed = score && score->final_score && criteria;
+  if (criteria) {
+    for (const auto& c : criteria->criteria) completed = completed && (c.met || c.kind == "time_limit");
+  }
+  j.key("completed").value(completed);
+  // The case's pass score (its file's [proficiency] pass_score) and whether this attempt passed: the
+  // case completed, with a final score at or above it (a high score on a case left unfinished does
+  // not pass).
   if (score) j.field("pass_score", score->pass_score, "points (0..100)");
-  j.key("passed").value(score && score->final_score && score->total >= score->pass_score);
+  j.key("passed").value(completed && score->total >= score->pass_score);
   // The physics period, from the samples' own time and step (1 ms when the log has none).
   j.field("step_period", last_step > 0 ? last_t / static_cast<double>(last_step) : 0.001, "s");
   j.end_object();

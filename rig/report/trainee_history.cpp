@@ -31,6 +31,7 @@ struct Attempt {
   std::int64_t started_us = 0;
   double total = 0;
   bool final_score = false;
+  bool completed = false;            // every criterion but the time limit met (its report's case.completed)
   std::optional<double> pass_score;  // the case's, as its report carries it
   std::vector<std::pair<std::string, double>> categories;
 };
@@ -78,6 +79,12 @@ HistoryFiles write_history(const std::string& root, const std::string& trainee, 
       a.started_us = j.at("case").value("started_utime_us", std::int64_t{0});
       a.total = j.at("score").at("total").at("value").get<double>();
       a.final_score = j.at("score").at("final").get<bool>();
+      if (j.at("case").contains("completed")) {
+        a.completed = j.at("case").at("completed").get<bool>();
+      } else {  // a report written before it said so: from its criteria, as the report does
+        a.completed = a.final_score;
+        for (const auto& c : j.at("criteria")) a.completed = a.completed && (c.at("met").get<bool>() || c.at("kind").get<std::string>() == "time_limit");
+      }
       if (j.at("case").contains("pass_score")) a.pass_score = j.at("case").at("pass_score").at("value").get<double>();
       for (const auto& c : j.at("score").at("categories")) a.categories.emplace_back(c.at("name").get<std::string>(), c.at("value").at("value").get<double>());
       by_case[j.at("case").at("id").get<std::string>()].push_back(std::move(a));
@@ -125,14 +132,16 @@ HistoryFiles write_history(const std::string& root, const std::string& trainee, 
     for (std::size_t i = 0; i < attempts.size(); ++i) {
       const Attempt& a = attempts[i];
       best = std::max(best, a.total);
-      if (first_pass == 0 && a.final_score && a.total >= pass_score) first_pass = static_cast<int>(i) + 1;
+      const bool passed = a.completed && a.total >= pass_score;  // completed implies a final score
+      if (first_pass == 0 && passed) first_pass = static_cast<int>(i) + 1;
       j.begin_object();
       j.key("n").value(static_cast<std::int64_t>(i + 1));
       j.key("folder").value(a.folder);
       j.key("started_utime_us").value(a.started_us);
       j.field("total", a.total, "points (0..100)");
       j.key("final").value(a.final_score);
-      j.key("passed").value(a.final_score && a.total >= pass_score);
+      j.key("completed").value(a.completed);
+      j.key("passed").value(passed);
       j.key("categories").begin_object();
       for (const auto& [n, v] : a.categories) j.field(n, v, "points (0..100)");
       j.end_object();

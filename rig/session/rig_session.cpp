@@ -131,7 +131,11 @@ std::vector<std::string> score_lines(SimulationModel& model) {
   std::snprintf(buf, sizeof buf, "%.0f / 100 (", card.total);
   lines.push_back(buf + cats + ")");
   const double pass = model.scene().description.pass_score;
-  std::snprintf(buf, sizeof buf, "pass score %.0f: %s (%.1f)", pass, card.total >= pass ? "passed" : "not passed", card.total);
+  // Passing takes the case completed (every criterion met) as well as the score: a high score on a
+  // case left unfinished does not pass.
+  const bool completed = model.metrics().completed();
+  std::snprintf(buf, sizeof buf, "pass score %.0f: %s (%.1f%s)", pass, completed && card.total >= pass ? "passed" : "not passed", card.total,
+                completed ? "" : ", the case not completed");
   lines.push_back(buf);
   for (const core::CriterionProgress& c : model.metrics().criteria()) {
     std::snprintf(buf, sizeof buf, "%s%s%s: %.3g (goal %.3g) %s", core::to_string(c.kind), c.target.empty() ? "" : " ",

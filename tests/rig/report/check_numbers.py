@@ -52,7 +52,12 @@ with open(f"{session}/report.json") as f:
 # Score: total and every category, exactly as published.
 check("total", report["score"]["total"]["value"] == score.total, f'{report["score"]["total"]} vs {score.total}')
 check("pass score", report["case"]["pass_score"]["value"] == score.pass_score, f'{report["case"]["pass_score"]} vs {score.pass_score}')
-check("passed", report["case"]["passed"] == (score.final_score and score.total >= score.pass_score), report["case"]["passed"])
+# Completed: every criterion but the time limit met in the final criteria message; passed: completed
+# with a final total at or above the pass score.
+crit.met = list(crit.met)  # lcm-gen's decoder gives an iterator: read it once
+completed = bool(score.final_score) and all(bool(m) or k == "time_limit" for k, m in zip(crit.kind, crit.met))
+check("completed", report["case"]["completed"] == completed, report["case"]["completed"])
+check("passed", report["case"]["passed"] == (completed and score.total >= score.pass_score), report["case"]["passed"])
 check("final", report["score"]["final"] == bool(score.final_score))
 cats = {c["name"]: c["value"]["value"] for c in report["score"]["categories"]}
 check("categories", cats == dict(zip(score.name, score.value)), f"{cats} vs {dict(zip(score.name, score.value))}")

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # A trainee's history (vitreo-report --trainee ID ROOT): the sessions under ROOT that name the
 # trainee (DIR/trainee.txt, written by `vitreo --trainee ID`), per case in the order they started,
-# each attempt's total and categories equal to its own report.json, pass = a final score at or above
-# --pass; other trainees' and unnamed sessions left out; the page draws a learning curve per case in
+# each attempt's total and categories equal to its own report.json, pass = the case completed with a
+# final score at or above --pass (a high score on an unfinished case does not pass); other trainees' and unnamed sessions left out; the page draws a learning curve per case in
 # headless Chromium without console errors; a bad id or no sessions give a clear error.
 set -euo pipefail
 report=$1 session=$2 vitreo=${3:-}
@@ -48,9 +48,13 @@ for a in case["attempts"]:
     r = json.load(open(f'{root}/{a["folder"]}/report.json'))
     assert a["total"]["value"] == r["score"]["total"]["value"] and a["final"] == r["score"]["final"], (a, r["score"])
     assert {k: v["value"] for k, v in a["categories"].items()} == {c["name"]: c["value"]["value"] for c in r["score"]["categories"]}
-    assert a["passed"] == (r["score"]["final"] and r["score"]["total"]["value"] >= 25)
-assert case["attempts"][2]["passed"] and not case["attempts"][0]["passed"], case["attempts"]
-assert case["first_passed_attempt"] == 3 and case["best"]["value"] == max(a["total"]["value"] for a in case["attempts"])
+    assert a["completed"] == r["case"]["completed"], (a, r["case"])
+    assert a["passed"] == (r["case"]["completed"] and r["score"]["total"]["value"] >= 25)
+# The fixture is the clumsy surgeon cut at 8 s: the third attempt's score is final (the session ended)
+# and above 25, but the case was not completed, so no attempt passes.
+assert case["attempts"][2]["final"] and not case["attempts"][2]["completed"] and case["attempts"][2]["total"]["value"] >= 25, case["attempts"]
+assert not any(a["passed"] for a in case["attempts"]), case["attempts"]
+assert case["first_passed_attempt"] == 0 and case["best"]["value"] == max(a["total"]["value"] for a in case["attempts"])
 assert case["pass_score"]["value"] == 25 and case["pass_score_from"] == "--pass", case["pass_score"]
 print("history:", [(a["folder"], round(a["total"]["value"], 1), a["passed"]) for a in case["attempts"]])
 PY
@@ -68,7 +72,7 @@ assert case["pass_score"]["value"] == want and case["pass_score_from"] == "case 
 for a in case["attempts"]:
     r = json.load(open(f'{root}/{a["folder"]}/report.json'))
     assert r["case"]["pass_score"]["value"] == want
-    assert a["passed"] == r["case"]["passed"] == (r["score"]["final"] and r["score"]["total"]["value"] >= want), (a, r["case"])
+    assert a["passed"] == r["case"]["passed"] == (r["case"]["completed"] and r["score"]["total"]["value"] >= want), (a, r["case"])
 print("history with the case's own pass score", want, [(a["folder"], a["passed"]) for a in case["attempts"]])
 PY
 timeout 60 chromium --headless --no-sandbox --disable-gpu --no-first-run --user-data-dir="$work/profile" \
@@ -77,7 +81,43 @@ timeout 60 chromium --headless --no-sandbox --disable-gpu --no-first-run --user-
 if grep -E 'CONSOLE|Uncaught' "$work/console.txt"; then echo "console messages above"; exit 1; fi
 grep -q 'data-rendered="yes"' "$work/dom.html" && grep -q 'data-charts="1"' "$work/dom.html"
 grep -q '<canvas id="chart-case-0"[^>]*data-points="[1-9]' "$work/dom.html"
-grep -q 'passed at attempt 3' "$work/dom.html"
+grep -q 'not passed yet' "$work/dom.html"
+
+# The same final report with a total far above the pass score, still unfinished: once as this report
+# format writes it (case.completed false) and once as a report from before that field (the history
+# reads its criteria); and once completed (every criterion met), which passes.
+mkdir -p "$work/unfinished"
+python3 - "$work/root/c-third/report.json" "$work/unfinished" <<'PY'
+import copy, json, os, sys
+src, out = sys.argv[1:]
+r = json.load(open(src))
+assert r["score"]["final"] and not r["case"]["completed"] and not r["case"]["passed"] and r["criteria"], r["case"]
+def save(name, rep, day):
+    os.makedirs(f"{out}/{name}")
+    rep["case"]["started_utime_us"] = 1_800_000_000_000_000 + day * 86_400_000_000
+    json.dump(rep, open(f"{out}/{name}/report.json", "w"))
+new = copy.deepcopy(r)
+new["score"]["total"]["value"] = 99.0
+assert not all(c["met"] or c["kind"] == "time_limit" for c in new["criteria"]), new["criteria"]
+save("a-unfinished", new, 1)
+old = copy.deepcopy(new)
+del old["case"]["completed"], old["case"]["passed"]
+save("b-unfinished-older-report", old, 2)
+done = copy.deepcopy(r)
+done["case"]["completed"] = True
+for c in done["criteria"]:
+    c["met"] = True
+save("c-finished", done, 3)
+PY
+"$report" "$work/unfinished" --trainee fellow-07 --pass 25 --generated "2026-01-01 00:00:00 UTC" > /dev/null
+python3 - "$work/unfinished/history-fellow-07.json" <<'PY'
+import json, sys
+(case,) = json.load(open(sys.argv[1]))["cases"]
+got = [(a["folder"], a["final"], a["completed"], a["passed"]) for a in case["attempts"]]
+assert got == [("a-unfinished", True, False, False), ("b-unfinished-older-report", True, False, False), ("c-finished", True, True, True)], got
+assert case["first_passed_attempt"] == 3 and case["best"]["value"] == 99.0, case
+print("unfinished attempts do not pass:", got)
+PY
 
 set +e
 "$report" "$work/root" --trainee '../x' > /dev/null 2> "$work/err.txt"; rc1=$?
