@@ -309,6 +309,7 @@ StepReport TissueWorld::step(double dt_s) {
     integrate_and_predict(h);
     add_point_terms(fraction);
     for (int it = 0; it < settings_.iterations; ++it) {
+      begin_sweep();
       sweep_vertices(h);
       project_contacts(h, fraction);
     }

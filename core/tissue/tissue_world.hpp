@@ -180,8 +180,8 @@ struct Energy {
 
 // The revision of the solver's arithmetic, bumped by every change that gives other bits for the same
 // inputs, so that a settled start cached by an older solver is not reused (rig/scene_io/case_loader.cpp;
-// a recording made by one still replays only on its own build). 1: bending read as constant rows
-// (build_bend_rows).
+// a recording still replays only on the build that made it). 1: the Vertex Block Descent solver of
+// core/README.md, the first revision counted.
 inline constexpr int kSolverRevision = 1;
 
 class TissueWorld {
@@ -352,14 +352,14 @@ class TissueWorld {
     double damping;            // k τ / h: the dashpot's coefficient over a substep
     double wake_length;        // the spring's length when that block fell asleep
   };
-  // A bending stencil (Surface::BendStencil) as the step sees it: its energy is
-  // ½ k |Σ_c K_c x_c − target|², the target fixed for the step (bend_rows turns the stencils of
-  // each vertex into one row of constant coefficients).
+  // A bending stencil (Surface::BendStencil) with its curvature vector kept current through the
+  // sweep: every vertex update adds K_i Δx_i, so a vertex reads H instead of four positions.
   struct Stencil {
     std::array<std::uint32_t, 4> v;  // a, b (the spring's ends), c, d (opposite vertices)
     std::array<double, 4> K;
     double k;       // µN/mm
     Vec3 target;    // h₀ n̂: the rest curvature along this step's stencil normal
+    Vec3 h;         // Σ K_i x_i, current within the sweep
   };
   struct StencilRef {
     std::uint32_t stencil;
@@ -452,14 +452,6 @@ class TissueWorld {
     // changes, pack_terms keeps it and refreshes the values from the springs and stencils they
     // came from (spring_edge, stencil_edge: the spring of each term and stencil).
     std::vector<std::uint32_t> spring_edge, stencil_edge;
-    // The bending energy's Hessian Q = Σ k K Kᵀ over the stencils is constant while the stencils'
-    // K and k are, so each active vertex's bending force is bend_force[i] − bend_diag[i] x_i −
-    // Σ_j Q_ij x_j: a row of its stencils' other corners (bend_begin CSR over bend_other and
-    // bend_coef), laid out with the layout and whenever the springs' values change
-    // (build_bend_rows), and bend_force = Σ k K_i target once a step (bend_rest_forces).
-    std::vector<std::uint32_t> bend_begin, bend_other;
-    std::vector<double> bend_coef, bend_diag;
-    std::vector<Vec3> bend_force;
     bool layout_valid = false;
     std::uint64_t layout_topology = 0, layout_awake = 0;
     // The surface's spring values and the dashpot factor the spring terms were last filled from.
@@ -484,8 +476,7 @@ class TissueWorld {
   void add_point_term(const PointTerm& term);
   void clear_point_terms();
   void reserve_point_terms();
-  void build_bend_rows(std::uint32_t si);
-  void bend_rest_forces(std::uint32_t si);
+  void begin_sweep();
   void sweep_vertices(double h);
   void measure_point_forces(double fraction_of_step);
   void project_contacts(double h, double fraction);
