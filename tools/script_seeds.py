@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""script_seeds.py CASE [--kind K | --script FILE] [--seeds 1-10] [--retina-vertices N] [--duration S]
+"""script_seeds.py CASE [CASE...] [--kind K | --script FILE] [--seeds 1-10] [--retina-vertices N] [--duration S]
                        [--jobs J] [--out DIR] [--vitreo PATH] [--require-rate R]
 
-Plays one case's surgical script through the whole stack (the main job, `vitreo --unpaced` without
+Plays each case's surgical script through the whole stack (the main job, `vitreo --unpaced` without
 frames or replay) once per sensor-noise seed (`vitreo --script-seed N`) and prints what each seed
 gave: the score, whether every criterion was met, each criterion's value, the iatrogenic events and
 the final state hash; then how often the criteria were met, and met cleanly (no iatrogenic event).
@@ -14,13 +14,19 @@ tipped by any change of the solver's bits (core/tissue/MEASUREMENTS.md, twenty-f
 
   tools/script_seeds.py scenes/low_membrane_macula.toml --seeds 1-10
   tools/script_seeds.py scenes/exercise_cut_path.toml --kind clumsy --seeds 1,4,9 --retina-vertices 0
+  tools/script_seeds.py scenes/*.toml --seeds 1-4 --vitreo OTHER_BUILD/rig/app/vitreo
+
+Several cases play one after the other, each with its own table, then one line a case (met, met
+cleanly, score median and range): how a change of the solver moves every expert at once. A file
+given among several that has no script of the kind (scenes/materials.toml) is passed over, said so.
 
 --kind picks scenes/scripts/CASE.KIND.toml beside the case (default expert); --script any other.
 --retina-vertices is vitreo's (default 5000, the rig's; 0 the case's own). --duration cuts every
 session short (vitreo --duration). Sessions run --jobs at a time (default 2) after the first, which
 settles the case's start into OUT/cache for the rest. Every session's folder (its report.json,
-telemetry and recording) is kept under OUT/seed-N (default: a new folder under /tmp, printed).
---require-rate R exits 1 when the criteria were met cleanly in fewer than R (0..1) of the seeds.
+telemetry and recording) is kept under OUT/seed-N, OUT/CASE/seed-N for several cases (default: a new
+folder under /tmp, printed).
+--require-rate R exits 1 when the criteria were met cleanly in fewer than R (0..1) of a case's seeds.
 Exit status 2: a session that did not run or wrote no report (its output is printed).
 """
 import argparse
@@ -59,9 +65,9 @@ def default_vitreo():
     return shutil.which("vitreo") or "vitreo"
 
 
-def run_seed(args, script, seed, out):
+def run_seed(args, case, script, seed, out):
     folder = out / f"seed-{seed}"
-    cmd = [args.vitreo, "--case", args.case, "--script", script, "--script-seed", str(seed),
+    cmd = [args.vitreo, "--case", str(case), "--script", script, "--script-seed", str(seed),
            "--retina-vertices", str(args.retina_vertices), "--no-render", "--no-verify", "--unpaced",
            "--out", str(folder), "--cache", str(out / "cache")]
     if args.duration is not None:
@@ -88,7 +94,7 @@ def run_seed(args, script, seed, out):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[1], formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", help="the case file (scenes/CASE.toml)")
+    ap.add_argument("case", nargs="+", help="the case file(s) (scenes/CASE.toml)")
     which = ap.add_mutually_exclusive_group()
     which.add_argument("--kind", default="expert", help="scenes/scripts/CASE.KIND.toml beside the case (default expert)")
     which.add_argument("--script", help="any other script for the case")
@@ -104,27 +110,55 @@ def main():
         ap.error("--jobs must be at least 1")
     if args.require_rate is not None and not 0.0 <= args.require_rate <= 1.0:
         ap.error("--require-rate must lie in 0..1")
-    case = pathlib.Path(args.case)
-    if not case.is_file():
-        ap.error(f"{args.case}: no such case file")
-    script = args.script or str(case.parent / "scripts" / f"{case.stem}.{args.kind}.toml")
-    if not pathlib.Path(script).is_file():
-        ap.error(f"{script}: no such script")
+    cases = [pathlib.Path(c) for c in args.case]
+    if args.script and len(cases) > 1:
+        ap.error("--script plays one case's script: give one case, or --kind for several")
+    plan = []  # (case, script)
+    for case in cases:
+        if not case.is_file():
+            ap.error(f"{case}: no such case file")
+        script = args.script or str(case.parent / "scripts" / f"{case.stem}.{args.kind}.toml")
+        if pathlib.Path(script).is_file():
+            plan.append((case, script))
+        elif len(cases) == 1:
+            ap.error(f"{script}: no such script")
+        else:
+            print(f"{case}: no {args.kind} script ({script}): passed over", flush=True)
+    if not plan:
+        ap.error(f"none of the files has a {args.kind} script")
     out = pathlib.Path(args.out) if args.out else pathlib.Path(tempfile.mkdtemp(prefix="script-seeds-"))
     out.mkdir(parents=True, exist_ok=True)
 
+    status = 0
+    tallies = []  # (case, met, clean, n, median, low, high)
+    for case, script in plan:
+        folder = out if len(plan) == 1 else out / case.stem
+        folder.mkdir(parents=True, exist_ok=True)
+        code, tally = play_case(args, case, script, folder)
+        status = max(status, code)
+        if tally:
+            tallies.append((case.stem,) + tally)
+    if len(plan) > 1:
+        print(f"\n{'case':<28}  {'met':<8}  {'cleanly':<8}  score median (range)")
+        for name, met, clean, n, median, low, high in tallies:
+            print(f"{name:<28}  {f'{met} of {n}':<8}  {f'{clean} of {n}':<8}  {median:.1f} ({low:.1f}-{high:.1f})")
+    return status
+
+
+def play_case(args, case, script, out):
+    """Plays one case's script over the seeds and prints its table; returns (exit code, tally)."""
     resolution = "the case's own resolution" if args.retina_vertices == 0 else f"{args.retina_vertices} retina vertices"
     print(f"{case.stem}: {script} at {resolution}, seeds {','.join(map(str, args.seeds))}; sessions in {out}", flush=True)
     # The first session settles the case's start into the cache; the rest read it.
-    results = [run_seed(args, script, args.seeds[0], out)]
+    results = [run_seed(args, case, script, args.seeds[0], out)]
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        results += list(pool.map(lambda s: run_seed(args, script, s, out), args.seeds[1:]))
+        results += list(pool.map(lambda s: run_seed(args, case, script, s, out), args.seeds[1:]))
 
     failed = [r for r in results if "error" in r]
     for r in failed:
         print(f"seed {r['seed']}: {r['error']}\n{r['output']}", file=sys.stderr)
     if failed:
-        return 2
+        return 2, None
     print(f"{'seed':>6}  {'score':>5}  {'passed':<6}  {'criteria met':<12}  {'iatrogenic':>10}  {'state hash':<16}  criteria")
     for r in results:
         crit = "; ".join(f"{c['kind']} {c['target']} {c['value']:.3g} (goal {c['threshold']:.3g})" for c in r["criteria"])
@@ -136,12 +170,12 @@ def main():
     scores = sorted(r["score"] for r in results)
     median = scores[n // 2] if n % 2 else 0.5 * (scores[n // 2 - 1] + scores[n // 2])
     print(f"criteria met in {met} of {n} seeds, cleanly (no iatrogenic event) in {clean}; "
-          f"score median {median:.1f}, range {scores[0]:.1f}-{scores[-1]:.1f}")
+          f"score median {median:.1f}, range {scores[0]:.1f}-{scores[-1]:.1f}", flush=True)
+    tally = (met, clean, n, median, scores[0], scores[-1])
     if args.require_rate is not None and clean < args.require_rate * n:
-        print(f"below the required rate: {clean} of {n} < {args.require_rate:g}", file=sys.stderr)
-        return 1
-    return 0
-
+        print(f"{case.stem}: below the required rate: {clean} of {n} < {args.require_rate:g}", file=sys.stderr)
+        return 1, tally
+    return 0, tally
 
 if __name__ == "__main__":
     sys.exit(main())

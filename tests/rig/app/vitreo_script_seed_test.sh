@@ -3,7 +3,8 @@
 # the summary names is the one played (no option: the script's own `seed = 1`; --script-seed 1 the
 # same session bit for bit); another seed is another noise realisation (another final state) and
 # its recording replays to it; the option is refused where nothing would play it; and the tool's
-# table gives, seed by seed, the final state and outcome of a session run directly with that seed.
+# table gives, seed by seed, the final state and outcome of a session run directly with that seed,
+# and over several cases one summary line a case.
 set -u
 vitreo=${1:?usage: vitreo_script_seed_test.sh <vitreo> <scenes> <tools/script_seeds.py>}
 scenes=${2:?}
@@ -79,6 +80,21 @@ rc=0; python3 "$tool" "$case_file" --seeds 1,2 --retina-vertices 1500 --duration
   --out "$tmp/tool" --require-rate 1 >"$tmp/tool2.out" 2>&1 || rc=$?
 want=$([ "$clean" = 2 ] && echo 0 || echo 1)
 check "--require-rate 1 exits $want with $clean of 2 clean (exit $rc)" '[ $rc -eq $want ]'
+# Several cases at once (as `scenes/*.toml` gives them): each its own table and folder, a file with no
+# expert script passed over, then one summary line a case that repeats that case's own tally.
+rc=0; python3 "$tool" "$case_file" "$scenes/materials.toml" "$scenes/exercise_navigation.toml" --seeds 1 \
+  --retina-vertices 1500 --duration 10 --jobs 1 --vitreo "$vitreo" --out "$tmp/multi" >"$tmp/multi.out" 2>&1 || rc=$?
+check "script_seeds.py over three files: exit 0" '[ $rc -eq 0 ]' || cat "$tmp/multi.out"
+check "the file without an expert script is passed over, said so" 'grep -q "materials.toml: no expert script" "$tmp/multi.out"'
+for c in low_membrane_macula exercise_navigation; do
+  check "$c has its own folder with its session" '[ -f "$tmp/multi/$c/seed-1/report.json" ]'
+  own=$(awk -v c="$c" '$1 == c":" {f=1} f && /^criteria met in/ {sub(";", "", $13); print $4, $13; exit}' "$tmp/multi.out")
+  summary=$(awk -v c="$c" '$1 == c && NF >= 8 {print $2, $5}' "$tmp/multi.out")
+  check "$c's summary line repeats its tally (met, cleanly: $own / $summary)" '[ -n "$own" ] && [ "$own" = "$summary" ]'
+done
+rc=0; python3 "$tool" "$case_file" "$scenes/exercise_navigation.toml" --script "$scenes/scripts/low_membrane_macula.expert.toml" \
+  >"$tmp/tool4.out" 2>&1 || rc=$?
+check "the tool refuses --script with several cases (exit $rc)" '[ $rc -eq 2 ] && grep -q "give one case" "$tmp/tool4.out"'
 rc=0; python3 "$tool" "$case_file" --seeds 3-1 >"$tmp/tool3.out" 2>&1 || rc=$?
 check "the tool refuses a backwards seed range (exit $rc)" '[ $rc -eq 2 ] && grep -q "runs backwards" "$tmp/tool3.out"'
 exit $fail
