@@ -23,9 +23,9 @@ given among several that has no script of the kind (scenes/materials.toml) is pa
 --kind picks scenes/scripts/CASE.KIND.toml beside the case (default expert); --script any other.
 --retina-vertices is vitreo's (default 5000, the rig's; 0 the case's own). --duration cuts every
 session short (vitreo --duration). Sessions run --jobs at a time (default 2) after the first, which
-settles the case's start into OUT/cache for the rest. Every session's folder (its report.json,
-telemetry and recording) is kept under OUT/seed-N, OUT/CASE/seed-N for several cases (default: a new
-folder under /tmp, printed).
+settles the case's start into a cache beside the sessions for the rest. Every session's folder (its
+report.json, telemetry and recording) is kept under OUT/seed-N, OUT/CASE/seed-N for several cases
+(default: a new folder under /tmp, printed).
 --require-rate R exits 1 when the criteria were met cleanly in fewer than R (0..1) of a case's seeds.
 Exit status 2: a session that did not run or wrote no report (its output is printed).
 """
@@ -130,17 +130,20 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
 
     status = 0
-    tallies = []  # (case, met, clean, n, median, low, high)
+    tallies = []  # (case, (met, clean, n, median, low, high) or None where a session failed)
     for case, script in plan:
         folder = out if len(plan) == 1 else out / case.stem
         folder.mkdir(parents=True, exist_ok=True)
         code, tally = play_case(args, case, script, folder)
         status = max(status, code)
-        if tally:
-            tallies.append((case.stem,) + tally)
+        tallies.append((case.stem, tally))
     if len(plan) > 1:
         print(f"\n{'case':<28}  {'met':<8}  {'cleanly':<8}  score median (range)")
-        for name, met, clean, n, median, low, high in tallies:
+        for name, tally in tallies:
+            if tally is None:
+                print(f"{name:<28}  a session did not run or wrote no report (its output is above)")
+                continue
+            met, clean, n, median, low, high = tally
             print(f"{name:<28}  {f'{met} of {n}':<8}  {f'{clean} of {n}':<8}  {median:.1f} ({low:.1f}-{high:.1f})")
     return status
 
