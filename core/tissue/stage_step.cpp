@@ -169,7 +169,20 @@ void TissueWorld::finish_sleep() {
     Scratch& sc = scratch_[si];
     s.note_awake_blocks_moved(sc.block_step_drift_mm);
     if (settings_.sleeping) {
-      s.update_sleep(sc.block_max_speed2, sleep2, static_cast<std::uint32_t>(settings_.sleep_after_steps));
+      // A block counts as slow only while every block it shares a spring with is slow too (a halo
+      // of one block). Without it a small block by a clamp or an attachment falls asleep while the
+      // tissue beyond it still creeps below the sleep speed, anchors that tissue, and the next
+      // block slows and sleeps in turn: a clamped flap froze 11 % short of its cantilever sag
+      // (core/tissue/MEASUREMENTS.md, 2026-11-29).
+      std::copy(sc.block_max_speed2.begin(), sc.block_max_speed2.end(), sc.block_sleep_speed2.begin());
+      const auto* ev = s.solver_view().edge_v.data();
+      for_each_active_edge(static_cast<std::uint32_t>(si), [&](std::uint32_t e) {
+        const std::uint32_t a = ev[e][0] / Surface::kSleepBlock, b = ev[e][1] / Surface::kSleepBlock;
+        if (a == b) return;
+        sc.block_sleep_speed2[a] = std::max(sc.block_sleep_speed2[a], sc.block_max_speed2[b]);
+        sc.block_sleep_speed2[b] = std::max(sc.block_sleep_speed2[b], sc.block_max_speed2[a]);
+      });
+      s.update_sleep(sc.block_sleep_speed2, sleep2, static_cast<std::uint32_t>(settings_.sleep_after_steps));
     }
     for (std::uint32_t b = 0; b < s.block_count(); ++b) {
       if (!sc.wake_request[b]) continue;

@@ -283,7 +283,9 @@ class Surface {
   // neighbours see its vertices as anchored, until something wakes it (a pull from an awake
   // neighbour, a changed force, an instrument, a topology change). Retina lying on the choroid is
   // most of the eye and at rest most of the time; this is what lets a 1 ms step afford it.
-  static constexpr std::uint32_t kSleepBlock = 64;
+  // 16, not more: on a revolved mesh a block is a strip of one ring, and a longer strip (64 was a
+  // third of a ring 60° from the pole) keeps still tissue beside any moving region awake.
+  static constexpr std::uint32_t kSleepBlock = 16;
   std::uint32_t block_count() const { return static_cast<std::uint32_t>(block_awake_.size()); }
   bool block_awake(std::uint32_t b) const { return block_awake_[b] != 0; }
   bool vertex_awake(std::uint32_t v) const { return block_awake_[v / kSleepBlock] != 0; }

@@ -83,6 +83,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.awake_blocks.assign(blocks, 0);
   s.wake_request.assign(blocks, 0);
   s.block_max_speed2.assign(blocks, 0.0);
+  s.block_sleep_speed2.assign(blocks, 0.0);
   s.block_max_move2.assign(blocks, 0.0);
   s.block_step_drift_mm.assign(blocks, 0.0);
   s.block_sleep_serial.assign(blocks, 0);

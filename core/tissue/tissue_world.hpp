@@ -181,8 +181,9 @@ struct Energy {
 // The revision of the solver's arithmetic, bumped by every change that gives other bits for the same
 // inputs, so that a settled start cached by an older solver is not reused (rig/scene_io/case_loader.cpp;
 // a recording still replays only on the build that made it). 1: bending read as constant rows
-// (backed out); 2: the Vertex Block Descent solver of core/README.md as before it.
-inline constexpr int kSolverRevision = 2;
+// (backed out); 2: the Vertex Block Descent solver of core/README.md as before it; 3: sleep blocks of
+// 16 vertices instead of 64, a block sleeping only while its spring neighbours are slow too.
+inline constexpr int kSolverRevision = 3;
 
 class TissueWorld {
  public:
@@ -421,6 +422,9 @@ class TissueWorld {
     std::uint32_t awake_block_count = 0;
     std::vector<std::uint8_t> wake_request;     // set during a step, applied at its end
     std::vector<double> block_max_speed2;
+    // What decides each block's sleep (finish_sleep): the largest of block_max_speed2 over the block
+    // and every block it shares a spring with. Not state: recomputed at the end of every step.
+    std::vector<double> block_sleep_speed2;
     // Largest displacement² of each block's vertices in the current substep, and their sum (of
     // the roots) over this step's substeps: how far any vertex of the block can have moved, for
     // Surface::block_drift_mm. Not state: reset at the start of every step.

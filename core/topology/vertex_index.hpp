@@ -4,11 +4,12 @@
 //
 // The patches are runs of kPatch consecutive vertex slots (in mesh order: short strips of
 // surface), each with a bounding box of its live vertices' current positions; each sleep block
-// keeps the union of its four patch boxes. A query is a pass over the block boxes (a few hundred on
-// the 20k-vertex retina), then over the patch boxes of the blocks it overlaps, and a scan of the
-// vertices of the patches it overlaps. Every box is fitted at construction. Patches are a quarter of a
-// sleep block: a sleep block of a revolved mesh is an arc of a ring 10 mm long, so a query for a
-// thin shape across it (a blade's stroke) would scan the whole arc.
+// keeps the union of its patch boxes. A query is a pass over the block boxes, then over the patch
+// boxes of the blocks it overlaps, and a scan of the vertices of the patches it overlaps. Every box
+// is fitted at construction. A patch is at most 16 slots however large a sleep block is: a strip of
+// a revolved mesh's ring longer than that is an arc several mm long, and a query for a thin shape
+// across it (a blade's stroke) would scan the whole arc. With today's sleep blocks of 16
+// (Surface::kSleepBlock) a block is one patch (~1 300 blocks on the 20k-vertex retina).
 //
 // Positions change every step, and reading them all again before each query would cost as much as
 // the query itself, so the index keeps a box until it may be wrong where it matters, using the

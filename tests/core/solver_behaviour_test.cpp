@@ -310,7 +310,7 @@ TEST(SolverBehaviour, RestingTissueSleepsAndWakesWhenPulled) {
   };
   const Outcome sleeping = run(true);
   const Outcome reference = run(false);
-  const std::uint32_t blocks = (static_cast<std::uint32_t>(small_retina().retina_vertices) + 63) / 64;
+  const std::uint32_t blocks = (static_cast<std::uint32_t>(small_retina().retina_vertices) + Surface::kSleepBlock - 1) / Surface::kSleepBlock;
   EXPECT_LE(sleeping.awake_before, blocks / 20) << "a retina at rest on the choroid should (almost all) sleep";
   EXPECT_GT(sleeping.awake_during, sleeping.awake_before) << "pulling the anchors must wake the tissue around them";
   // Intraocular pressure holds the attached retina on the wall (the wall takes the pressure only
