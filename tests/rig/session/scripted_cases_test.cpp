@@ -154,7 +154,10 @@ void check_case(const std::string& name, int vertices) {
               line("idle", idle.summary).c_str());
   EXPECT_FALSE(idle.summary.case_completed);
   EXPECT_LE(idle.summary.score.total, 15.0);
-  EXPECT_EQ(category(idle.summary, "target_achievement"), 0.0);
+  // Nothing to the tenth of a point the debrief shows: a detachment left alone still settles by a
+  // micrometre or so (exercise_drain_tear's lift 2.4446 -> 2.4435 mm in 12.5 s), which retina_flat's
+  // progress counts.
+  EXPECT_LT(category(idle.summary, "target_achievement"), 0.05);
   EXPECT_EQ(idle.summary.totals.iatrogenic_events(), 0u);
   EXPECT_EQ(idle.summary.totals.retina_tears, 0u);
   check_report(idle);
