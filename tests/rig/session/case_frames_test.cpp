@@ -131,22 +131,11 @@ void expect_golden(const vr::Image& full, const std::string& name) {
   const vr::ImageDiff d = vr::compare_images(actual, vr::read_png(golden), 24);
   std::printf("golden %s: %s\n", name.c_str(), d.summary().c_str());
   ::testing::Test::RecordProperty("rmse_" + name, std::to_string(d.rmse));
-  // The sanitizer builds are compiled at -O1, whose floating point comes out in other bits than -O2's
-  // (the U tear's cached settled start differs byte for byte between the two builds), and the U
-  // tear's bullous detachment — the one large lifted area among the cases — then settles a little
-  // differently and is shaded so over its whole area: rmse 4.5 against this golden at -O1, 0.8 at
-  // -O2, and 0.8 again when the -O1 build renders the -O2 build's settled start. That is physics, not
-  // rendering, so those builds allow twice the rmse; the share of pixels far off stays as tight.
-#ifdef VITREO_SANITIZER_BUILD
-  constexpr double kMaxRmse = 6.0;
-#else
-  constexpr double kMaxRmse = 3.0;
-#endif
-  if (!(d.same_size && d.rmse <= kMaxRmse && d.fraction_over <= 0.015)) {
+  if (!(d.same_size && d.rmse <= 3.0 && d.fraction_over <= 0.015)) {
     mkdir("golden-actual", 0755);
     const std::string out = "golden-actual/" + name + ".png";
     vr::write_png(out, actual);
-    ADD_FAILURE() << "golden " << name << " differs: " << d.summary() << " (limits rmse<=" << kMaxRmse << ", over(24)<=1.5%); actual written to "
+    ADD_FAILURE() << "golden " << name << " differs: " << d.summary() << " (limits rmse<=3, over(24)<=1.5%); actual written to "
                   << out;
   }
 }
