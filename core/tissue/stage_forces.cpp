@@ -157,6 +157,7 @@ void TissueWorld::compute_external_accelerations(double h) {
           at *= at_norm > friction ? 1.0 - friction / at_norm : 0.0;
           a = at + an * normal;
           sc.contact_load[v] = reaction;  // the wall's normal load, per unit inertia
+          sc.contact_normal[v] = normal;
         }
       }
       sc.acceleration[v] = a;

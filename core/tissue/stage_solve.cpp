@@ -5,11 +5,12 @@
 //   G(y) = Σ_i ½ m̃_i |y_i − x̃_i|² / h² + E(y),
 // x̃ the inertial target (position + h × velocity + h² × external acceleration, with the implicit
 // drag folded into m̃: see Scratch::effective_inverse_mass) and E every elastic term: springs
-// (½ k (|d| − L)²), bending stencils (½ k |H − h₀ n̂|²), attachments, grips and instrument contacts
-// (½ k |p − target|², one-sided for contacts), and the springs' dashpots (Rayleigh damping,
-// ½ (k τ / h) (n · Δd)² over the substep). A vertex's step holds its neighbours and takes one Newton
-// step on its own terms: f = −∂G/∂y_i, H = ∂²G/∂y_i² (the spring's Hessian clamped to be positive
-// semi-definite, as in VBD), y_i += H⁻¹ f, then the globe wall keeps it inside.
+// (½ k (|d| − L)²), bending stencils (½ k |Σ K x − h₀ n̂|², read as constant rows: build_bend_rows),
+// attachments, grips and instrument contacts (½ k |p − target|², one-sided for contacts), and the
+// springs' dashpots (Rayleigh damping, ½ (k τ / h) (n · Δd)² over the substep). A vertex's step holds
+// its neighbours and takes one Newton step on its own terms: f = −∂G/∂y_i, H = ∂²G/∂y_i² (the
+// spring's Hessian clamped to be positive semi-definite, as in VBD), y_i += H⁻¹ f, then the globe
+// wall keeps it inside.
 //
 // Where the sweep starts decides what an unconverged sweep gives. It starts from y = x + h v (where
 // inertia alone carries the tissue, without this substep's external forces): for tissue at rest in
@@ -100,6 +101,7 @@ void TissueWorld::pack_terms(double h) {
     if (!relayout_every_step_ && sc.layout_valid && same_vertices && sc.layout_topology == s.topology_version() &&
         sc.layout_awake == s.awake_version() && refresh_packed_values(si, h)) {
       ++layouts_kept_;
+      bend_rest_forces(si);
       continue;
     }
 
@@ -179,7 +181,65 @@ void TissueWorld::pack_terms(double h) {
     sc.layout_awake = s.awake_version();
     sc.layout_spring_values = s.spring_values_version();
     sc.layout_damping_per_k = damping_per_k;
+    build_bend_rows(si);
+    bend_rest_forces(si);
   }
+}
+
+// Each active vertex's row of the bending Hessian Q = Σ_stencils k K Kᵀ: its diagonal and one entry
+// per other corner of its stencils (a vertex's own spring neighbours and the far corners of the
+// stencils it is an opposite corner of: about twelve on a regular mesh), summed in the order of
+// the vertex's stencils. Q is constant while the stencils' K and k are (they change with the
+// topology and the springs' values, when the rows are built again), so the sweep reads one row
+// instead of twelve stencils, and nothing has to follow a vertex's move.
+void TissueWorld::build_bend_rows(std::uint32_t si) {
+  Scratch& sc = scratch_[si];
+  std::uint32_t end = 0;
+  for (std::uint32_t q = 0; q < sc.active_count; ++q) {
+    const std::uint32_t v = sc.active[q];
+    const std::uint32_t begin = end;
+    sc.bend_begin[q] = begin;
+    double diagonal = 0.0;
+    for (std::uint32_t k = sc.stencil_begin[q], stop = sc.stencil_begin[q + 1]; k < stop; ++k) {
+      const StencilRef r = sc.stencil_refs[k];
+      const Stencil& st = sc.stencils[r.stencil];
+      const double k_mine = st.k * st.K[r.corner];
+      for (std::uint32_t c = 0; c < 4; ++c) {
+        const double coef = k_mine * st.K[c];
+        const std::uint32_t j = st.v[c];
+        if (j == v) {
+          diagonal += coef;
+          continue;
+        }
+        std::uint32_t at = begin;
+        while (at < end && sc.bend_other[at] != j) ++at;
+        if (at == end) {
+          sc.bend_other[end] = j;
+          sc.bend_coef[end++] = 0.0;
+        }
+        sc.bend_coef[at] += coef;
+      }
+    }
+    sc.bend_diag[q] = diagonal;
+  }
+  sc.bend_begin[sc.active_count] = end;
+}
+
+// The constant part of each active vertex's bending force this step, Σ k K_i target over its
+// stencils (their targets follow the stencils' normals at the step's start).
+void TissueWorld::bend_rest_forces(std::uint32_t si) {
+  Scratch& sc = scratch_[si];
+  run_sliced(workers_.get(), sc.active_count, [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t q = begin; q < end; ++q) {
+      Vec3 b = Vec3::Zero();
+      for (std::uint32_t k = sc.stencil_begin[q], stop = sc.stencil_begin[q + 1]; k < stop; ++k) {
+        const StencilRef r = sc.stencil_refs[k];
+        const Stencil& st = sc.stencils[r.stencil];
+        b += (st.k * st.K[r.corner]) * st.target;
+      }
+      sc.bend_force[q] = b;
+    }
+  });
 }
 
 // The same layout as the last step's: each stencil and, where any spring's rest length or stiffness
@@ -213,6 +273,7 @@ bool TissueWorld::refresh_packed_values(std::uint32_t si, double h) {
     return false;
   }
   if (sc.layout_spring_values == s.spring_values_version() && sc.layout_damping_per_k == damping_per_k) return true;
+  const bool stencils_changed = sc.layout_spring_values != s.spring_values_version();  // their K and k follow the springs
   sc.layout_spring_values = s.spring_values_version();
   sc.layout_damping_per_k = damping_per_k;
   run_sliced(workers_.get(), sc.spring_begin[sc.active_count], [&](std::uint32_t begin, std::uint32_t end) {
@@ -225,21 +286,8 @@ bool TissueWorld::refresh_packed_values(std::uint32_t si, double h) {
       t.damping = k * damping_per_k;
     }
   });
+  if (stencils_changed) build_bend_rows(si);
   return true;
-}
-
-// The stencils' curvature vectors from the positions the sweep starts at.
-void TissueWorld::begin_sweep() {
-  for (std::uint32_t si = 0; si < surfaces_.size(); ++si) {
-    Scratch& sc = scratch_[si];
-    const Vec3* x = surfaces_[si]->solver_view().x.data();
-    run_sliced(workers_.get(), sc.stencil_count, [&](std::uint32_t begin, std::uint32_t end) {
-      for (std::uint32_t i = begin; i < end; ++i) {
-        Stencil& st = sc.stencils[i];
-        st.h = st.K[0] * x[st.v[0]] + st.K[1] * x[st.v[1]] + st.K[2] * x[st.v[2]] + st.K[3] * x[st.v[3]];
-      }
-    });
-  }
 }
 
 void TissueWorld::sweep_vertices(double h) {
@@ -284,13 +332,11 @@ void TissueWorld::sweep_vertices(double h) {
         stretch_stiffness += t.k * (1.0 + 2.0 * transverse);
       }
 
-      for (std::uint32_t k = sc.stencil_begin[q], end = sc.stencil_begin[q + 1]; k < end; ++k) {
-        const StencilRef r = sc.stencil_refs[k];
-        const Stencil& st = sc.stencils[r.stencil];
-        const double kk = st.K[r.corner];
-        f -= (st.k * kk) * (st.h - st.target);
-        add_diagonal(H, st.k * kk * kk);
-      }
+      // Bending: −∂/∂y of Σ ½ k |Σ K x − target|², from the vertex's row of constant coefficients.
+      Vec3 bend = sc.bend_force[q] - sc.bend_diag[q] * y;
+      for (std::uint32_t k = sc.bend_begin[q], end = sc.bend_begin[q + 1]; k < end; ++k) bend -= sc.bend_coef[k] * x[sc.bend_other[k]];
+      f += bend;
+      add_diagonal(H, sc.bend_diag[q]);
 
       // Friction with the wall where the vertex lies on it pressed by a normal load N: up to μ N
       // against its tangential motion u in this substep, as a smoothed stick–slip force (the
@@ -300,7 +346,7 @@ void TissueWorld::sweep_vertices(double h) {
       // whenever a detachment or an instrument pulls on it.
       if (sc.contact_load[v] > 0.0) {
         const double limit = friction * sc.contact_load[v] * sc.velocity_keep[v] / w[v];
-        const Vec3 n = (y - wall_.center()).normalized();
+        const Vec3& n = sc.contact_normal[v];
         const Vec3 u = moved - n * n.dot(moved);
         const double slip = std::max(u.norm(), kStick_mm);
         f -= (limit / slip) * u;
@@ -341,12 +387,7 @@ void TissueWorld::sweep_vertices(double h) {
                                                                           : Scratch::kStartInertial;
       Vec3 next = y + solve_spd3(H, f);
       if (walled && wall_.project_inside(next, offset)) sc.wall_touched[v] = 1;
-      const Vec3 delta = next - y;
       x[v] = next;
-      for (std::uint32_t k = sc.stencil_begin[q], end = sc.stencil_begin[q + 1]; k < end; ++k) {
-        const StencilRef r = sc.stencil_refs[k];
-        sc.stencils[r.stencil].h += sc.stencils[r.stencil].K[r.corner] * delta;
-      }
     }
   }
 }

@@ -55,8 +55,7 @@ void TissueWorld::integrate_and_predict(double h) {
       if (sc.contact_load[v] > 0.0) {
         // Lying on the wall: no velocity into it (an inelastic contact), and Coulomb friction
         // takes up to μ·load·h of the sliding speed each substep, so attached retina stays put.
-        const Vec3 radial = view.x[v] - wall_.center();
-        const Vec3 normal = radial * (1.0 / radial.norm());
+        const Vec3& normal = sc.contact_normal[v];
         const double vn = view.v[v].dot(normal);
         if (vn > 0.0) view.v[v] -= vn * normal;
         const double vt = view.v[v].norm();
@@ -322,7 +321,6 @@ StepReport TissueWorld::step(double dt_s) {
     integrate_and_predict(h);
     add_point_terms(fraction);
     for (int it = 0; it < settings_.iterations; ++it) {
-      begin_sweep();
       sweep_vertices(h);
       project_contacts(h, fraction);
     }

@@ -76,6 +76,7 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.effective_inverse_mass.resize(cap);
   s.current_area.resize(cap);
   s.contact_load.resize(cap);
+  s.contact_normal.resize(cap);
   s.wall_touched.resize(cap);
   s.momentum.assign(cap, 0);
   const std::size_t blocks = surface->block_count();
@@ -100,6 +101,12 @@ std::uint32_t TissueWorld::add_surface(const SurfaceDescription& description) {
   s.stencil_edge.resize(surface->edge_capacity());
   s.stencil_refs.resize(4 * std::size_t{surface->edge_capacity()});
   s.stencils.resize(surface->edge_capacity());
+  // A stencil's four corners give each of them three other corners: at most 12 row entries a spring.
+  s.bend_begin.resize(cap + 1);
+  s.bend_other.resize(12 * std::size_t{surface->edge_capacity()});
+  s.bend_coef.resize(s.bend_other.size());
+  s.bend_diag.resize(cap);
+  s.bend_force.resize(cap);
   s.target.resize(cap);
   s.point_head.assign(cap, kNone);
   surfaces_.push_back(std::move(surface));

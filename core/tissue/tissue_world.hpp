@@ -183,7 +183,9 @@ struct Energy {
 // a recording still replays only on the build that made it). 1: bending read as constant rows
 // (backed out); 2: the Vertex Block Descent solver of core/README.md as before it; 3: sleep blocks of
 // 16 vertices instead of 64, a block sleeping only while its spring neighbours are slow too.
-inline constexpr int kSolverRevision = 3;
+// 4: bending read as constant rows again, on the sleep blocks of 16, and the wall friction
+// directed by the contact normal taken once a step (Scratch::contact_normal).
+inline constexpr int kSolverRevision = 4;
 
 class TissueWorld {
  public:
@@ -353,14 +355,14 @@ class TissueWorld {
     double damping;            // k τ / h: the dashpot's coefficient over a substep
     double wake_length;        // the spring's length when that block fell asleep
   };
-  // A bending stencil (Surface::BendStencil) with its curvature vector kept current through the
-  // sweep: every vertex update adds K_i Δx_i, so a vertex reads H instead of four positions.
+  // A bending stencil (Surface::BendStencil) as the step sees it: its energy is
+  // ½ k |Σ_c K_c x_c − target|², the target fixed for the step (bend_rows turns the stencils of
+  // each vertex into one row of constant coefficients).
   struct Stencil {
     std::array<std::uint32_t, 4> v;  // a, b (the spring's ends), c, d (opposite vertices)
     std::array<double, 4> K;
     double k;       // µN/mm
     Vec3 target;    // h₀ n̂: the rest curvature along this step's stencil normal
-    Vec3 h;         // Σ K_i x_i, current within the sweep
   };
   struct StencilRef {
     std::uint32_t stencil;
@@ -404,6 +406,11 @@ class TissueWorld {
     std::uint64_t area_epoch = 0;
     // Normal load (acceleration) with which a vertex lies on the globe wall; 0 when not in contact.
     std::vector<double> contact_load;
+    // Where contact_load > 0: the wall's outward unit normal under the vertex at the step's start,
+    // used for the contact's friction in every substep (the normal turns by ~1e-4 rad over the
+    // micrometres a vertex on the wall moves in a step; taking it once saves a root and a division
+    // per vertex and substep in the prediction and again in the sweep). Set with contact_load.
+    std::vector<Vec3> contact_normal;
     // Set when the wall moved the vertex in this substep: its velocity into the wall is then
     // removed (an inelastic contact, as in the velocity pass of Müller et al. 2020) so it cannot
     // bounce between wall and springs from one substep to the next.
@@ -456,6 +463,14 @@ class TissueWorld {
     // changes, pack_terms keeps it and refreshes the values from the springs and stencils they
     // came from (spring_edge, stencil_edge: the spring of each term and stencil).
     std::vector<std::uint32_t> spring_edge, stencil_edge;
+    // The bending energy's Hessian Q = Σ k K Kᵀ over the stencils is constant while the stencils'
+    // K and k are, so each active vertex's bending force is bend_force[i] − bend_diag[i] x_i −
+    // Σ_j Q_ij x_j: a row of its stencils' other corners (bend_begin CSR over bend_other and
+    // bend_coef), laid out with the layout and whenever the springs' values change
+    // (build_bend_rows), and bend_force = Σ k K_i target once a step (bend_rest_forces).
+    std::vector<std::uint32_t> bend_begin, bend_other;
+    std::vector<double> bend_coef, bend_diag;
+    std::vector<Vec3> bend_force;
     bool layout_valid = false;
     std::uint64_t layout_topology = 0, layout_awake = 0;
     // The surface's spring values and the dashpot factor the spring terms were last filled from.
@@ -480,7 +495,8 @@ class TissueWorld {
   void add_point_term(const PointTerm& term);
   void clear_point_terms();
   void reserve_point_terms();
-  void begin_sweep();
+  void build_bend_rows(std::uint32_t si);
+  void bend_rest_forces(std::uint32_t si);
   void sweep_vertices(double h);
   void measure_point_forces(double fraction_of_step);
   void project_contacts(double h, double fraction);
