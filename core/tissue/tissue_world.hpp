@@ -356,8 +356,8 @@ class TissueWorld {
     double wake_length;        // the spring's length when that block fell asleep
   };
   // A bending stencil (Surface::BendStencil) as the step sees it: its energy is
-  // ½ k |Σ_c K_c x_c − target|², the target fixed for the step (bend_rows turns the stencils of
-  // each vertex into one row of constant coefficients).
+  // ½ k |Σ_c K_c x_c − target|², the target fixed for the step (build_bend_rows turns the stencils
+  // of each vertex into one row of constant coefficients).
   struct Stencil {
     std::array<std::uint32_t, 4> v;  // a, b (the spring's ends), c, d (opposite vertices)
     std::array<double, 4> K;
