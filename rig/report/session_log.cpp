@@ -69,14 +69,16 @@ void take_device_status(const vitreo_lcm::device_status_t& m, SessionLog& log) {
   d.timestamp_jumps = m.timestamp_jumps;
   d.reader_stalls = m.reader_stalls;
   d.reader_stall_max_ms = m.reader_stall_max_ms;
-  // A spell ends when a status no longer says it, and begins when one first does.
+  // A spell ends when a status no longer says it, and begins when one first does, at the session
+  // time the status was taken (not where the telemetry thread happened to publish it among the
+  // physics' messages: a loaded machine drains those late and in bulk).
   const std::string now = spell_of(m);
   DeviceSpell* open = !d.spells.empty() && d.spells.back().to_s < 0 ? &d.spells.back() : nullptr;
   if (open && open->what != now) {
-    open->to_s = log.latest_t_s;
+    open->to_s = m.t_s;
     open = nullptr;
   }
-  if (!open && !now.empty()) d.spells.push_back({now, log.latest_t_s, -1, m.detail});
+  if (!open && !now.empty()) d.spells.push_back({now, m.t_s, -1, m.detail});
 }
 
 // Records one decoded event; false when its bytes did not decode as its channel's type.
@@ -96,7 +98,6 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     s.actuation = m.actuation;
     s.retina_force_un = m.retina_force_un;
     s.frozen = m.frozen;
-    log.latest_t_s = std::max(log.latest_t_s, s.t_s);
     log.tips.push_back(std::move(s));
   } else if (ev.channel == t::kChanEvent) {
     vitreo_lcm::event_t m{};
@@ -185,7 +186,6 @@ bool take(const telemetry::LcmLogEvent& ev, SessionLog& log) {
     }
     c.macula_dose_j_cm2 = m.macula_light_dose_j_cm2;
     c.dose_limit_j_cm2 = m.light_dose_limit_j_cm2;
-    log.latest_t_s = std::max(log.latest_t_s, c.t_s);
     log.controls.push_back(c);
   } else if (ev.channel == t::kChanDeviceStatus) {
     vitreo_lcm::device_status_t m{};

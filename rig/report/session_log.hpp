@@ -96,8 +96,8 @@ struct ControlsRecord {
 // A spell in which a device was not simply working: "lost" (link gone), "stuck" (bit-identical
 // samples for 50 ms or more of device time; a tracker's instrument frozen), "stale" (no sample for a
 // while), "refused" (ERROR: another device, serial or protocol version than the rig file's). Times are
-// the session's (the newest step time the log had published before the status), to the status
-// messages' 10 Hz.
+// the session's, as the statuses carry them (device_status_t.t_s): a link change and a stuck verdict
+// are published at once, staleness to the statuses' 10 Hz.
 struct DeviceSpell {
   std::string what;
   double from_s = 0;
@@ -136,7 +136,6 @@ struct SessionLog {
   std::vector<TotalsRecord> totals;
   std::vector<ControlsRecord> controls;
   std::vector<DeviceRecord> devices;  // in order of their first status
-  double latest_t_s = 0;              // while reading: the newest session time published so far
 };
 
 // Reads the whole log (see above for what is an error and what a notice).

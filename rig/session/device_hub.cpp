@@ -183,7 +183,7 @@ void DeviceHub::run_lockstep_drivers() {
       }
       std::this_thread::yield();
     }
-    for (auto& d : devices_) changed = changed || d->driver->session().state() != d->last_state;
+    for (auto& d : devices_) changed = changed || status_changed(*d);
     const std::uint64_t now = clock_.now_us();
     if (now >= next_status || changed) {  // 10 Hz of simulated time
       publish_status(now);
@@ -254,17 +254,25 @@ void DeviceHub::run_drivers() {
     bool changed = false;
     for (auto& d : devices_) {
       d->driver->poll(0);
-      changed = changed || d->driver->session().state() != d->last_state;
+      changed = changed || status_changed(*d);
     }
     const std::uint64_t now = clock_.now_us();
-    // 10 Hz (rig/telemetry/CHANNELS.md), and at once when a link changes state: a loss that the
-    // driver recovers from within 100 ms must still reach the technician's telemetry.
+    // 10 Hz (rig/telemetry/CHANNELS.md), and at once when a link changes state or the sensor sticks
+    // or moves again: a loss that the driver recovers from within 100 ms must still reach the
+    // technician's telemetry.
     if (now >= next_status || changed) {
       publish_status(now);
       next_status = now + 100'000;
     }
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
+}
+
+// A status goes out at once, not at the next 10 Hz tick, when the link's state or the sensor's
+// stuck verdict differs from what the last status said.
+bool DeviceHub::status_changed(const Device& d) {
+  const auto& session = d.driver->session();
+  return session.state() != d.last_state || session.stuck() != d.stuck_published;
 }
 
 void DeviceHub::publish_status(std::uint64_t now_us) {
@@ -277,6 +285,7 @@ void DeviceHub::publish_status(std::uint64_t now_us) {
       if (!d->refusal_reported.empty()) spdlog::error("device {} ({}): refused: {}", d->spec.name, d->driver->uri(), d->refusal_reported);
     }
     d->last_state = session.state();
+    d->stuck_published = session.stuck();
     if (!status_out_) continue;
     const SampleWindow::Measured w = d->window.measure(now_us);
     telemetry::DeviceMeasured measured;
@@ -285,6 +294,8 @@ void DeviceHub::publish_status(std::uint64_t now_us) {
     measured.latency_p99_us = w.latency_p99_us;
     measured.reader_stalls = reader_stalls();
     measured.reader_stall_max_ms = static_cast<float>(reader_stall_max_us()) * 1e-3f;
+    const std::uint64_t origin = session_origin_us_.load(std::memory_order_acquire);
+    measured.session_t_s = origin != 0 && now_us > origin ? static_cast<double>(now_us - origin) * 1e-6 : 0.0;
     status_out_->push(
         telemetry::device_status_item(d->spec.device_id, d->spec.name, d->driver->uri(), session, now_us, measured, d->spec.calibration));
   }

@@ -94,6 +94,9 @@ class DeviceHub {
   // The clock the devices' samples are stamped with (host monotonic µs; in lockstep the granted
   // simulation time): what the rig stamps its own inputs with, so a recording's host times agree.
   std::uint64_t now_us() { return clock_.now_us(); }
+  // Physics side, at the session's first step: the origin of the session time the device statuses
+  // carry (device_status_t.t_s) — in lockstep the start time, so a status's time is its step's k · dt.
+  void mark_session_start() { session_origin_us_.store(clock_.now_us(), std::memory_order_release); }
   // Before start(): called on the driver thread for each completed time-sync exchange of `device`
   // (vitreo-calibrate's clock calibration).
   void on_time_sync(std::size_t device, drivers::DeviceSession::TimeSyncFn f) {
@@ -129,6 +132,7 @@ class DeviceHub {
     std::atomic<int> plug_request{0};  // +1 plug, -1 unplug
     drivers::LinkState last_state = drivers::LinkState::lost;  // as last published (driver thread)
     bool stuck_reported = false;                              // driver thread
+    bool stuck_published = false;                             // as last published (driver thread)
     std::uint64_t bytes_unaccounted = 0;  // lockstep: bytes a stalled grant gave up on (driver thread)
     SampleWindow window;                  // rate and latency of the last second (driver thread)
     std::string refusal_reported;         // the refusal last logged (driver thread)
@@ -140,6 +144,7 @@ class DeviceHub {
   void step_peers(std::uint64_t now_us);
   std::uint64_t grant_round();  // lockstep: one round at the clock's current time; returns its number
   void publish_status(std::uint64_t now_us);
+  static bool status_changed(const Device& d);
 
   // The drivers' clock: the steady wall clock, or in lockstep the granted simulation time.
   class HubClock final : public drivers::Clock {
@@ -167,6 +172,7 @@ class DeviceHub {
   std::atomic<bool> drivers_opened_{false};  // lockstep: the drivers opened their ports before round 1
   LockstepStats lock_stats_;
   std::atomic<std::uint64_t> reader_stalls_{0}, reader_stall_max_us_{0};
+  std::atomic<std::uint64_t> session_origin_us_{0};  // 0 until the session's first step
   std::thread sim_thread_, driver_thread_;
 };
 

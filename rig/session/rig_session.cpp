@@ -273,6 +273,7 @@ SessionSummary run_session(const SessionConfig& config) {
     const int stop = config.stop ? config.stop->load(std::memory_order_relaxed) : 0;
     const bool case_done = config.end_at_case_over && case_over_step.load(std::memory_order_relaxed) >= 0;
     const bool last = k + 1 == config.steps || stop != 0 || case_done;
+    if (k == 0) hub.mark_session_start();
     if (config.on_step) config.on_step(k, hub);
     auto consume = [&](const telemetry::RecordedInput& in) {
       telemetry::RecordedInput stamped = in;

@@ -66,6 +66,7 @@ struct PhysicsTiming {
 };
 
 struct DeviceStatus {
+  double t_s = 0;  // session time of the hub's clock (device_status_t.lcm)
   std::int32_t device_id = 0;
   char name[24] = {};
   char transport[96] = {};

@@ -245,6 +245,7 @@ DeviceStatus device_status_item(std::int32_t device_id, std::string_view name, s
   s.sequence_gaps = static_cast<std::int64_t>(st.drops);
   s.heartbeat_misses = static_cast<std::int64_t>(st.heartbeat_misses);
   s.reconnects = static_cast<std::int64_t>(st.reconnects);
+  s.t_s = measured.session_t_s;
   s.sample_rate_hz = measured.sample_rate_hz;
   s.latency_p50_us = measured.latency_p50_us;
   s.latency_p99_us = measured.latency_p99_us;
@@ -318,6 +319,7 @@ vitreo_lcm::physics_timing_t to_lcm(const PhysicsTiming& v, std::int64_t utime_u
 vitreo_lcm::device_status_t to_lcm(const DeviceStatus& v, std::int64_t utime_us) {
   vitreo_lcm::device_status_t m;
   m.utime_us = utime_us;
+  m.t_s = v.t_s;
   m.device_id = v.device_id;
   m.name = text(v.name);
   m.transport = text(v.transport);

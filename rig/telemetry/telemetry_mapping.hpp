@@ -103,6 +103,7 @@ struct DeviceMeasured {
   float latency_p50_us = 0, latency_p99_us = 0;
   std::uint64_t reader_stalls = 0;
   float reader_stall_max_ms = 0;
+  double session_t_s = 0;  // the hub's clock since the session's first step (device_status_t.t_s)
 };
 DeviceStatus device_status_item(std::int32_t device_id, std::string_view name, std::string_view transport,
                                 const drivers::DeviceSession& session, std::uint64_t now_us, const DeviceMeasured& measured,

@@ -59,17 +59,24 @@ if tracker:
     def spells(what):
         return [s for s in tracker["spells"] if s["what"] == what]
     stuck, lost = spells("stuck"), spells("lost")
-    # Stuck means 50 ms of bit-identical samples; the status goes out at 10 Hz and with each change.
-    check("the tracker's stuck spell", len(stuck) == 1 and 2.0 <= stuck[0]["from"]["value"] <= 2.2 and stuck[0]["to"] is not None
-          and 2.55 <= stuck[0]["to"]["value"] <= 2.8, stuck)
+    # Stuck means 50 ms of bit-identical samples; a status goes out at once when the verdict changes,
+    # carrying the session time it was taken at (in lockstep the step's), so the spell is timed to
+    # the step however the telemetry thread was scheduled: 2.05 s (50 ms after the sensor hung) to
+    # 2.6 s (its first moving sample), each to a tracker sample (1 ms) and a step.
+    check("the tracker's stuck spell", len(stuck) == 1 and 2.049 <= stuck[0]["from"]["value"] <= 2.053 and stuck[0]["to"] is not None
+          and 2.599 <= stuck[0]["to"]["value"] <= 2.603, stuck)
+    tracker_statuses = [s for s in statuses if s.name == "tracker-0"]
+    first_stuck = next((s for s in tracker_statuses if s.stuck), None)
+    moving_again = next((s for s in tracker_statuses if first_stuck and s.t_s > first_stuck.t_s and not s.stuck), None)
+    check("the stuck spell is timed by the statuses' own session time",
+          stuck and first_stuck and moving_again and stuck[0]["from"]["value"] == first_stuck.t_s
+          and stuck[0]["to"]["value"] == moving_again.t_s, (stuck, first_stuck and first_stuck.t_s, moving_again and moving_again.t_s))
     check("one stuck episode counted", tracker["stuck_episodes"] == 1, tracker["stuck_episodes"])
     check("samples frozen while stuck", tracker["stuck_samples"] > 50, tracker["stuck_samples"])
     # Lost once the link hangs up (or is silent past the rig's timeout), found again after the
-    # reconnect. A spell is timed by the newest sample published before its status, and the
-    # telemetry thread interleaves the statuses with the physics' messages as it drains them, so a
-    # spell's ends are known to a few telemetry periods (here: within 50 ms).
-    check("the tracker's lost spell", len(lost) == 1 and 3.95 <= lost[0]["from"]["value"] <= 4.6 and lost[0]["to"] is not None
-          and 4.75 <= lost[0]["to"]["value"] <= 5.6, lost)
+    # reconnect, each end published at once with the session time of the step it happened at.
+    check("the tracker's lost spell", len(lost) == 1 and 3.999 <= lost[0]["from"]["value"] <= 4.3 and lost[0]["to"] is not None
+          and 4.799 <= lost[0]["to"]["value"] <= 5.2, lost)
     check("the reconnect", tracker["reconnects"] >= 1, tracker["reconnects"])
     check("the clock jump", tracker["timestamp_jumps"] >= 1, tracker["timestamp_jumps"])
     for words in ("stuck 1 time", "lost 1 time", "samples frozen while stuck", "timestamp jump", "reconnect"):

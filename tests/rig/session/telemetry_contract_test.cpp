@@ -276,7 +276,12 @@ TEST(TelemetryContract, DeviceStatusFillsEveryFieldAndCountsRejectionsByCause) {
         EXPECT_GE(s.frames_tx, p.frames_tx);
         EXPECT_GE(s.bytes_rx, p.bytes_rx);
         EXPECT_GE(s.utime_us, p.utime_us);
+        EXPECT_GE(s.t_s, p.t_s) << "session time runs forward";
       }
+      // t_s: in lockstep the granted step's time, k · 1 ms, within the session's 1500 steps.
+      EXPECT_GE(s.t_s, 0.0);
+      EXPECT_LT(s.t_s, 1.5);
+      EXPECT_NEAR(s.t_s * 1000.0, std::round(s.t_s * 1000.0), 1e-6) << "a whole step: " << s.t_s;
       if (healthy) {
         // Younger than the lost timeout (the stale one, 20 ms, is the session's verdict at its own
         // poll, which on a loaded machine may come a little before this publish).
@@ -290,6 +295,7 @@ TEST(TelemetryContract, DeviceStatusFillsEveryFieldAndCountsRejectionsByCause) {
       }
     }
     const M& last = all.back();
+    EXPECT_GT(last.t_s, 1.35) << "10 Hz of session time to the end";
     EXPECT_EQ(int{last.state}, int{M::STATE_ACTIVE});
     EXPECT_GE(last.frames_tx, 4) << "identify, rate, streaming, time sync at least";
     EXPECT_GT(last.frames_rx, 0);

@@ -78,7 +78,7 @@ TEST(DeviceStatusMapping, EveryRejectionArrivesUnderItsOwnCause) {
   EXPECT_EQ(int{wrong_kind.state}, int{M::STATE_ERROR});
   EXPECT_NE(wrong_kind.detail.find("expected type 1"), std::string::npos) << wrong_kind.detail;
   s.on_frame(VP_OK, device_info(2, VP_DEVICE_TRACKER, VP_PROTO_MAJOR + 1), 4000);
-  const M m = published(s, 4000, {812.5f, 120.0f, 480.0f, 3, 21.5f});
+  const M m = published(s, 4000, {812.5f, 120.0f, 480.0f, 3, 21.5f, 4.25});
   EXPECT_EQ(int{m.state}, int{M::STATE_ERROR}) << "refused: not silently 'connecting' for ever";
   EXPECT_NE(m.detail.find("protocol 2."), std::string::npos) << m.detail;
   EXPECT_EQ(m.crc_errors, 1);
@@ -95,6 +95,7 @@ TEST(DeviceStatusMapping, EveryRejectionArrivesUnderItsOwnCause) {
   EXPECT_EQ(m.transport, "serial:/dev/ttyACM0");
   // What the hub measures goes through as it is.
   EXPECT_FLOAT_EQ(m.sample_rate_hz, 812.5f);
+  EXPECT_DOUBLE_EQ(m.t_s, 4.25) << "the session time the hub took it at";
   EXPECT_FLOAT_EQ(m.latency_p50_us, 120.0f);
   EXPECT_FLOAT_EQ(m.latency_p99_us, 480.0f);
   EXPECT_EQ(m.reader_stalls, 3);
