@@ -430,10 +430,19 @@ int main(int argc, char** argv) {
     for (const auto& line : s.cases_loaded) std::printf("  case loaded      %s\n", line.c_str());
     std::printf("  simulated        %.3f s in %llu steps (%s)\n", s.simulated_s, static_cast<unsigned long long>(s.steps),
                 s.stop_reason == "duration reached" ? "the whole duration" : ("stopped early by " + s.stop_reason).c_str());
-    std::printf("  step time        p50 %.0f us, p99 %.0f us, max %.0f us; %llu overruns, %llu late, %llu dropped\n",
+    // Said so that nobody reads "dropped" as steps lost: a paced loop that falls behind gives up
+    // deadlines (the session runs longer than real time), never steps; and in lockstep a step's time
+    // includes the devices' round, which the outcome does not depend on.
+    std::printf("  step time        p50 %.0f us, p99 %.0f us, max %.0f us; %llu steps over the %g ms period, %llu started late, "
+                "%llu deadlines given up",
                 s.loop.step_p50_ns * 1e-3, s.loop.step_p99_ns * 1e-3, s.loop.step_max_ns * 1e-3,
-                static_cast<unsigned long long>(s.loop.overruns), static_cast<unsigned long long>(s.loop.late_steps),
+                static_cast<unsigned long long>(s.loop.overruns), model.dt_s * 1e3, static_cast<unsigned long long>(s.loop.late_steps),
                 static_cast<unsigned long long>(s.loop.dropped_steps));
+    if (s.loop.dropped_steps > 0)
+      std::printf(" (%.1f s behind the wall clock; every step simulated)", static_cast<double>(s.loop.slip_ns) * 1e-9);
+    if (config.device_mode == vitreo::rig::HubMode::lockstep)
+      std::printf("; lockstep: a step includes the devices' round, and the outcome does not depend on its time");
+    std::printf("\n");
     std::printf("  inputs           %llu applied, %llu refused, %llu recorded (%llu dropped)\n",
                 static_cast<unsigned long long>(s.inputs_applied), static_cast<unsigned long long>(s.inputs_refused),
                 static_cast<unsigned long long>(s.inputs_recorded), static_cast<unsigned long long>(s.recorder_dropped));
